@@ -1,0 +1,63 @@
+#pragma once
+/// @file
+/// Sweep-and-prune broad phase over fixed arrays (paper 3.3.1 and 4.1).
+///
+/// Each body is an interval [lo, hi] on one sweep axis, from its position and its bounding
+/// (largest possible) radius, so the interval does not jump when the collision radius changes.
+/// The intervals are kept sorted by lo with an insertion sort: between two steps bodies move
+/// little, the array is nearly sorted, and the sort costs O(n + swaps). The sweep then visits
+/// each body's successors until their lo passes its hi.
+
+#include "statsim/config.hpp"
+
+#include <cstdint>
+
+namespace statsim {
+
+/// A candidate pair of bodies, by index.
+struct Pair {
+  std::uint32_t a;
+  std::uint32_t b;
+};
+
+/// One body's interval on the sweep axis.
+struct SweepEntry {
+  Scalar lo;
+  Scalar hi;
+  std::uint32_t body;
+};
+
+namespace detail {
+
+/// Sorts `entries` by `lo`, stably, in place. Returns the number of element moves, which is small
+/// when the order is coherent from frame to frame.
+inline std::uint32_t insertion_sort(SweepEntry* entries, std::uint32_t count)
+{
+  std::uint32_t moves = 0;
+  for (std::uint32_t i = 1; i < count; ++i) {
+    const SweepEntry e = entries[i];
+    std::uint32_t j = i;
+    while (j > 0 && entries[j - 1].lo > e.lo) {
+      entries[j] = entries[j - 1];
+      --j;
+    }
+    moves += i - j;
+    entries[j] = e;
+  }
+  return moves;
+}
+
+/// Calls `overlap(body_a, body_b)` for every pair of entries whose intervals overlap
+/// (lo_b <= hi_a with b after a in the sorted order). `entries` must be sorted by lo.
+template <class OnOverlap>
+void sweep(const SweepEntry* entries, std::uint32_t count, OnOverlap&& overlap)
+{
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const Scalar hi = entries[i].hi;
+    const std::uint32_t a = entries[i].body;
+    for (std::uint32_t j = i + 1; j < count && entries[j].lo <= hi; ++j) overlap(a, entries[j].body);
+  }
+}
+
+}  // namespace detail
+}  // namespace statsim

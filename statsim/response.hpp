@@ -1,0 +1,125 @@
+#pragma once
+/// @file
+/// Particle (solid sphere) collision response with restitution and Coulomb friction, for body
+/// against plane and body against body. The statistical response of the paper builds its
+/// V_particle+ on the same rule.
+///
+/// With the contact point at r from the centre, the contact velocity is u = v + w x r. The normal
+/// impulse is j_n = -(1 + e) u.n / (sum of inverse masses); the tangential impulse opposes the
+/// slip u_t and is the smaller of mu j_n (sliding) and the impulse that stops the slip (sticking):
+/// for a solid sphere (I = k m R^2) a tangential impulse j changes the slip by
+/// j (1/m)(1 + 1/k), so sticking needs |u_t| / ((1/m)(1 + 1/k)) per body. Neither impulse can add
+/// kinetic energy: restitution e <= 1, and friction never exceeds the impulse that stops the slip.
+
+#include "statsim/math.hpp"
+
+namespace statsim {
+
+/// Surface properties of a contact.
+struct Material {
+  /// Coefficient of restitution, 0 (no bounce) to 1 (elastic). Typical: 0.3.
+  Scalar restitution = Scalar(0.3);
+  /// Coulomb friction coefficient, >= 0. Typical: 0.5.
+  Scalar friction = Scalar(0.5);
+  /// Rolling resistance coefficient, >= 0: each contact takes up to this times the normal
+  /// impulse off the rolling speed, and the spin in proportion, so that a rolling body stops
+  /// (on the ground, a deceleration of about this times g). Typical: 0.01 to 0.1.
+  Scalar rolling_resistance = Scalar(0.05);
+};
+
+/// Combined material of two touching bodies: the larger restitution (a bouncy body bounces on
+/// anything), the geometric mean of the frictions (a frictionless body slides on anything) and
+/// the larger rolling resistance.
+inline Material mix(const Material& a, const Material& b)
+{
+  return {a.restitution > b.restitution ? a.restitution : b.restitution, std::sqrt(a.friction * b.friction),
+          a.rolling_resistance > b.rolling_resistance ? a.rolling_resistance : b.rolling_resistance};
+}
+
+/// One side of a contact: the velocities are updated in place.
+template <int D>
+struct ContactSide {
+  typename Space<D>::Vec& velocity;     ///< m/s
+  typename Space<D>::Spin& spin;        ///< rad/s
+  Scalar inv_mass;                      ///< 1/kg; 0 for a static or sleeping body
+  Scalar radius;                        ///< m, centre to contact point
+};
+
+/// Resolves the contact of `a` and `b` along the unit normal `n` (pointing from a to b).
+/// Returns true when the bodies were approaching and an impulse was applied. Below
+/// `restitution_threshold` (m/s of approach) the contact is treated as inelastic, so that resting
+/// contacts do not jitter.
+template <int D>
+bool particle_response(ContactSide<D> a, ContactSide<D> b, const typename Space<D>::Vec& n,
+                       const Material& m, Scalar restitution_threshold)
+{
+  using Vec = typename Space<D>::Vec;
+  const Scalar inv_k = Scalar(1) / Space<D>::inertia_factor;
+  const Vec ra = n * a.radius;
+  const Vec rb = n * -b.radius;
+  const Vec u = (b.velocity + detail::cross(b.spin, rb)) - (a.velocity + detail::cross(a.spin, ra));
+  const Scalar vn = u.dot(n);
+  const Scalar inv_mass_sum = a.inv_mass + b.inv_mass;
+  if (vn >= 0 || inv_mass_sum <= 0) return false;
+
+  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
+  const Scalar jn = -(1 + e) * vn / inv_mass_sum;
+  Vec impulse = n * jn;
+
+  const Vec ut = u - n * vn;
+  const Scalar slip = ut.norm();
+  if (slip > Scalar(0)) {
+    const Scalar jt_stick = slip / (inv_mass_sum * (1 + inv_k));
+    const Scalar jt_slide = m.friction * jn;
+    const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
+    impulse -= ut * (jt / slip);
+  }
+  // Impulse `impulse` acts on b at rb and its opposite on a at ra; I^-1 = inv_mass / (k R^2).
+  b.velocity += impulse * b.inv_mass;
+  a.velocity -= impulse * a.inv_mass;
+  if (b.radius > 0) b.spin += detail::moment(rb, impulse) * (b.inv_mass * inv_k / (b.radius * b.radius));
+  if (a.radius > 0) a.spin -= detail::moment(ra, impulse) * (a.inv_mass * inv_k / (a.radius * a.radius));
+
+  // Rolling resistance: each body's tangential velocity relative to the other and its spin
+  // shrink by the same factor, which takes at most rolling_resistance * j_n * inv_mass off the
+  // rolling speed and never adds energy (a factor in [0, 1] on each term).
+  if (m.rolling_resistance > 0) {
+    const Vec rel = b.velocity - a.velocity;
+    const Vec rel_t = rel - n * rel.dot(n);
+    const Scalar speed = rel_t.norm();
+    const Scalar cut = m.rolling_resistance * jn * inv_mass_sum;
+    const Scalar f = speed > cut ? 1 - cut / speed : Scalar(0);
+    // Both tangential velocities move toward their mass-weighted mean, which conserves momentum
+    // and leaves a static side (inverse mass 0) where it is.
+    const Vec mean = (a.velocity * b.inv_mass + b.velocity * a.inv_mass) / inv_mass_sum;
+    const Vec mean_t = mean - n * mean.dot(n);
+    a.velocity += (a.velocity - n * a.velocity.dot(n) - mean_t) * (f - 1);
+    b.velocity += (b.velocity - n * b.velocity.dot(n) - mean_t) * (f - 1);
+    if (a.inv_mass > 0) a.spin = a.spin * f;
+    if (b.inv_mass > 0) b.spin = b.spin * f;
+  }
+  return true;
+}
+
+/// Body against a static plane with unit normal `n` (pointing out of the plane, towards the
+/// body). Mass cancels out, so none is needed.
+template <int D>
+bool particle_plane_response(typename Space<D>::Vec& velocity, typename Space<D>::Spin& spin, Scalar radius,
+                             const typename Space<D>::Vec& n, const Material& m, Scalar restitution_threshold)
+{
+  typename Space<D>::Vec plane_velocity = Space<D>::Vec::Zero();
+  typename Space<D>::Spin plane_spin = Space<D>::zero_spin();
+  // The plane is side a (static, normal from it to the body), the body side b with unit mass.
+  return particle_response<D>({plane_velocity, plane_spin, 0, 0}, {velocity, spin, 1, radius}, n, m,
+                              restitution_threshold);
+}
+
+/// Kinetic energy of a solid sphere (or disc in 2D) of mass `mass` and radius `radius`, J.
+template <int D>
+Scalar kinetic_energy(const typename Space<D>::Vec& v, const typename Space<D>::Spin& w, Scalar mass, Scalar radius)
+{
+  const Scalar inertia = Space<D>::inertia_factor * mass * radius * radius;
+  return Scalar(0.5) * (mass * v.squaredNorm() + inertia * detail::squared_norm(w));
+}
+
+}  // namespace statsim

@@ -1,0 +1,68 @@
+#pragma once
+/// @file
+/// Result codes of the runtime. Every call that can fail returns one; a call that fails changes
+/// nothing.
+
+#include <cstdint>
+
+namespace statsim {
+
+/// Outcome of a public call.
+enum class Status : std::uint8_t {
+  ok = 0,
+  capacity_exceeded,     ///< the fixed pool is full: raise the world's template capacity
+  non_finite,            ///< a position, velocity, mass, radius or gravity was NaN or infinite
+  zero_quaternion,       ///< orientation had (near) zero length
+  non_unit_quaternion,   ///< orientation length differed from 1 by more than 1e-3
+  invalid_time_step,     ///< dt was not finite and positive
+  invalid_plane,         ///< plane normal was zero or not finite, or offset not finite
+  invalid_radius,        ///< a radius was not positive, or bounding radius < collision radius
+  invalid_mass,          ///< mass was not positive
+  invalid_material,      ///< restitution outside [0, 1] or friction negative
+  invalid_shape,         ///< shape id does not name a shape of this world
+  invalid_body,          ///< body id does not name a body of this world
+  invalid_parameter,     ///< a world parameter is out of its documented range
+};
+
+/// Short, stable name of a status, for messages ("capacity_exceeded").
+constexpr const char* to_string(Status s)
+{
+  switch (s) {
+    case Status::ok: return "ok";
+    case Status::capacity_exceeded: return "capacity_exceeded";
+    case Status::non_finite: return "non_finite";
+    case Status::zero_quaternion: return "zero_quaternion";
+    case Status::non_unit_quaternion: return "non_unit_quaternion";
+    case Status::invalid_time_step: return "invalid_time_step";
+    case Status::invalid_plane: return "invalid_plane";
+    case Status::invalid_radius: return "invalid_radius";
+    case Status::invalid_mass: return "invalid_mass";
+    case Status::invalid_material: return "invalid_material";
+    case Status::invalid_shape: return "invalid_shape";
+    case Status::invalid_body: return "invalid_body";
+    case Status::invalid_parameter: return "invalid_parameter";
+  }
+  return "unknown";
+}
+
+/// Pools that can overflow during a step. `StepResult::overflow` is a bit set of these; each
+/// names the template argument to raise.
+enum Overflow : std::uint32_t {
+  overflow_none = 0,
+  /// More candidate pairs than the pair buffer holds: raise the world's `MaxPairs`. The pairs
+  /// beyond it were not resolved this step (their count is in `StepResult::pairs_dropped`).
+  overflow_pairs = 1u << 0,
+};
+
+/// What a call to `step()` did.
+struct StepResult {
+  Status status = Status::ok;        ///< ok, or invalid_time_step (then nothing was stepped)
+  std::uint32_t overflow = overflow_none;  ///< bit set of `Overflow`
+  std::uint32_t pairs_found = 0;     ///< candidate pairs from the broad phase (incl. dropped)
+  std::uint32_t pairs_dropped = 0;   ///< candidate pairs that did not fit the pair buffer
+  std::uint32_t contacts = 0;        ///< body-body and body-plane contacts resolved
+  /// True when the step ran and nothing overflowed.
+  constexpr bool ok() const { return status == Status::ok && overflow == overflow_none; }
+};
+
+}  // namespace statsim

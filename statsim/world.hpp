@@ -1,0 +1,658 @@
+#pragma once
+/// @file
+/// The world: fixed-capacity arrays of bodies and planes, and `step()`.
+///
+/// `World<D, MaxBodies, ...>` owns the storage; everything it does is implemented once in the
+/// capacity-erased `WorldCore<D>`, so helpers can take a `WorldCore<3>&` whatever the capacity and
+/// the code is compiled once per dimension, not once per capacity.
+///
+/// A step, in order:
+///  1. integrate awake bodies (semi-implicit Euler; orientation without trigonometry);
+///  2. broad phase: sweep-and-prune on the bounding radius;
+///  3. impact pass: body-plane then body-body contacts get the response (particle response for
+///     now); planes push bodies out of them;
+///  4. support passes (`WorldDef::support_iterations`): inelastic, removing approach velocity
+///     left at resting contacts, planes last;
+///  5. shock pass: contacts from the bottom up, the lower body immovable; overlaps between bodies
+///     are corrected here, softly (`allowed_overlap`, `overlap_correction`);
+///  6. motion state: moving, settling (slow and touching), asleep (slow for `sleep_time`).
+/// Sleeping bodies are not integrated and act as static supports until hit harder than
+/// `wake_speed`.
+
+#include "statsim/broadphase.hpp"
+#include "statsim/contact.hpp"
+#include "statsim/random.hpp"
+#include "statsim/response.hpp"
+#include "statsim/status.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <limits>
+
+namespace statsim {
+
+/// Index of a body in its world, in order of creation.
+using BodyId = std::uint32_t;
+/// Index of a shape in its world, in order of creation.
+using ShapeId = std::uint16_t;
+/// Index of a plane in its world, in order of creation.
+using PlaneId = std::uint16_t;
+
+/// What a body is doing.
+enum class MotionState : std::uint8_t {
+  moving,    ///< free flight or fast contact
+  settling,  ///< touching something and slower than `WorldDef::settle_speed`
+  asleep,    ///< not integrated; acts as a static support until hit hard enough
+};
+
+/// A shape: what all bodies made from it share. Built like Box2D's defs: start from the defaults
+/// and set what differs.
+struct ShapeDef {
+  /// Radius of the collision sphere, m. Typical: 0.05 to 1.
+  Scalar radius = Scalar(0.1);
+  /// Radius of a sphere about the centre of mass that holds the whole shape, m; the broad phase
+  /// uses it. 0 means "same as radius". Must be >= radius.
+  Scalar bounding_radius = 0;
+  /// Restitution and friction of the shape's surface.
+  Material material{};
+};
+
+/// Initial state of a body.
+template <int D>
+struct BodyDef {
+  using Vec = typename Space<D>::Vec;
+  Vec position = Vec::Zero();                                 ///< centre of mass, m
+  typename Space<D>::Rot orientation = Space<D>::identity();  ///< body to world; unit length
+  Vec linear_velocity = Vec::Zero();                          ///< m/s
+  typename Space<D>::Spin angular_velocity = Space<D>::zero_spin();  ///< rad/s, world frame
+  ShapeId shape = 0;                                          ///< from `add_shape`
+  Scalar mass = 1;                                            ///< kg, > 0
+  bool asleep = false;                                        ///< start asleep (e.g. a pre-built pile)
+};
+
+/// Parameters of a world. Defaults suit bodies of 5 cm to 1 m at 30 to 240 Hz.
+template <int D>
+struct WorldDef {
+  using Vec = typename Space<D>::Vec;
+  /// Gravity, m/s^2. Default: 9.81 down the up axis (-z in 3D, -y in 2D).
+  Vec gravity = -Scalar(9.81) * Vec::Unit(Space<D>::up_axis);
+  /// Seed of every random stream; body i draws from stream `body_stream(seed, i)`.
+  std::uint64_t seed = 0x5eed5eedull;
+  /// Approach speed below which contacts do not bounce, m/s. Keep it above |g| dt (0.16 at
+  /// 60 Hz) so that resting bodies do not jitter.
+  Scalar restitution_threshold = Scalar(0.5);
+  /// A touching body slower than this is settling, m/s (speed = max(|v|, |w| R_bound)).
+  Scalar settle_speed = Scalar(0.5);
+  /// A touching body slower than this for `sleep_time` falls asleep, m/s.
+  Scalar sleep_speed = Scalar(0.05);
+  /// Seconds a touching body must stay below `sleep_speed` before it sleeps, >= 0.
+  Scalar sleep_time = Scalar(0.5);
+  /// An awake body hitting a sleeping one faster than this (normal approach, m/s) wakes it;
+  /// slower, the sleeper acts as a static support.
+  Scalar wake_speed = Scalar(0.5);
+  /// Velocity damping, 1/s: v *= 1 / (1 + dt c). 0 = none.
+  Scalar linear_damping = 0;
+  /// Spin damping, 1/s. 0 = none.
+  Scalar angular_damping = 0;
+  /// Contact passes after the impact pass, >= 1 (paper: 1). Each takes out approach velocity
+  /// left at resting contacts; a stack of k layers needs about k passes to hold still in one step.
+  int support_iterations = 4;
+  /// After the support passes, one bottom-up pass that settles stacks exactly (see `step`).
+  bool shock_propagation = true;
+  /// Overlap of two bodies left uncorrected, as a fraction of the sum of their radii, in [0, 0.5).
+  /// Typical: 0.01 to 0.05. Resting contacts keep about this much overlap.
+  Scalar allowed_overlap = Scalar(0.02);
+  /// Fraction of the remaining overlap of two bodies removed per step, in (0, 1]. Typical: 0.2
+  /// to 0.8; 1 corrects in full, which makes packed piles churn.
+  Scalar overlap_correction = Scalar(0.5);
+  /// Axis the broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
+  /// along, not the up axis of a pile.
+  int sweep_axis = 0;
+};
+
+/// Full state of a body. Read it through `WorldCore::body()`; change it only through the world.
+template <int D>
+struct Body {
+  using Vec = typename Space<D>::Vec;
+  Vec position;                           ///< centre of mass, m
+  typename Space<D>::Rot orientation;     ///< body to world, unit
+  Vec linear_velocity;                    ///< m/s
+  typename Space<D>::Spin angular_velocity;  ///< rad/s
+  Scalar radius;                          ///< current collision radius, m
+  Scalar bounding_radius;                 ///< m
+  Scalar inv_mass;                        ///< 1/kg
+  Scalar slow_time;                       ///< s spent slow and touching
+  std::uint64_t rng_state;                ///< state of the body's PCG32 stream
+  ShapeId shape;
+  MotionState state;
+  bool touching;                          ///< touched a plane or body in the last step
+};
+
+/// Result of an `add_*` call: a status and, when ok, the new id.
+template <class Id>
+struct Added {
+  Status status;
+  Id id;
+  constexpr bool ok() const { return status == Status::ok; }
+};
+
+/// Shape data a world keeps.
+struct Shape {
+  Scalar radius;
+  Scalar bounding_radius;
+  Material material;
+};
+
+/// Capacity-erased world: all the logic, working on storage that `World<>` provides.
+template <int D>
+class WorldCore {
+ public:
+  using Vec = typename Space<D>::Vec;
+  using Rot = typename Space<D>::Rot;
+  using Spin = typename Space<D>::Spin;
+
+  WorldCore(const WorldCore&) = delete;
+  WorldCore& operator=(const WorldCore&) = delete;
+
+  /// Replaces the world's parameters. Rejected with `invalid_parameter` (or `non_finite`) if any
+  /// is out of range; the world then keeps the parameters it had.
+  Status configure(const WorldDef<D>& def)
+  {
+    const Status s = validate(def);
+    if (s == Status::ok) def_ = def;
+    return s;
+  }
+  const WorldDef<D>& def() const { return def_; }
+  /// Status of the parameters given at construction: if not ok, the world uses the defaults.
+  Status construction_status() const { return construction_status_; }
+
+  /// Registers a shape. Fails with `capacity_exceeded` when the shape pool is full.
+  Added<ShapeId> add_shape(const ShapeDef& def)
+  {
+    const Scalar bound = def.bounding_radius == 0 ? def.radius : def.bounding_radius;
+    if (!detail::finite(def.radius) || !detail::finite(bound) || !detail::finite(def.material.restitution) ||
+        !detail::finite(def.material.friction))
+      return {Status::non_finite, 0};
+    if (!(def.radius > 0) || bound < def.radius) return {Status::invalid_radius, 0};
+    if (!detail::finite(def.material.rolling_resistance)) return {Status::non_finite, 0};
+    if (def.material.restitution < 0 || def.material.restitution > 1 || def.material.friction < 0 ||
+        def.material.rolling_resistance < 0)
+      return {Status::invalid_material, 0};
+    if (shape_count_ == max_shapes_) return {Status::capacity_exceeded, 0};
+    shapes_[shape_count_] = Shape{def.radius, bound, def.material};
+    return {Status::ok, ShapeId(shape_count_++)};
+  }
+
+  /// Adds a static plane with the given normal (any length > 0; it is normalised) through the
+  /// point normal_unit * offset. Fails with `capacity_exceeded` when the plane pool is full.
+  Added<PlaneId> add_plane(const Vec& normal, Scalar offset)
+  {
+    if (!detail::finite(normal) || !detail::finite(offset)) return {Status::invalid_plane, 0};
+    const Scalar len = normal.norm();
+    if (!(len > Scalar(1e-12)) || !detail::finite(len)) return {Status::invalid_plane, 0};
+    if (plane_count_ == max_planes_) return {Status::capacity_exceeded, 0};
+    planes_[plane_count_] = Plane<D>{normal / len, offset};
+    return {Status::ok, PlaneId(plane_count_++)};
+  }
+
+  /// Adds a body. Fails, adding nothing, on bad input or when the body pool is full.
+  Added<BodyId> add_body(const BodyDef<D>& def)
+  {
+    const Status s = check_state(def.position, def.orientation, def.linear_velocity, def.angular_velocity);
+    if (s != Status::ok) return {s, 0};
+    if (def.shape >= shape_count_) return {Status::invalid_shape, 0};
+    if (!detail::finite(def.mass)) return {Status::non_finite, 0};
+    if (!(def.mass > 0)) return {Status::invalid_mass, 0};
+    if (body_count_ == max_bodies_) return {Status::capacity_exceeded, 0};
+
+    const BodyId id = body_count_;
+    const Shape& shape = shapes_[def.shape];
+    Body<D>& b = bodies_[id];
+    b.position = def.position;
+    b.orientation = detail::normalized(def.orientation);
+    b.linear_velocity = def.asleep ? Vec::Zero() : def.linear_velocity;
+    b.angular_velocity = def.asleep ? Space<D>::zero_spin() : def.angular_velocity;
+    b.radius = shape.radius;
+    b.bounding_radius = shape.bounding_radius;
+    b.inv_mass = Scalar(1) / def.mass;
+    b.slow_time = 0;
+    b.rng_state = Pcg32(def_.seed, body_stream(def_.seed, id)).state();
+    b.shape = def.shape;
+    b.state = def.asleep ? MotionState::asleep : MotionState::moving;
+    b.touching = false;
+    entries_[id] = SweepEntry{0, 0, id};
+    ++body_count_;
+    return {Status::ok, id};
+  }
+
+  /// Sets a body's velocities and wakes it.
+  Status set_velocity(BodyId id, const Vec& linear, const Spin& angular)
+  {
+    if (id >= body_count_) return Status::invalid_body;
+    if (!detail::finite(linear) || !detail::finite(angular)) return Status::non_finite;
+    Body<D>& b = bodies_[id];
+    b.linear_velocity = linear;
+    b.angular_velocity = angular;
+    wake(b);
+    return Status::ok;
+  }
+
+  /// Moves a body and wakes it.
+  Status set_transform(BodyId id, const Vec& position, const Rot& orientation)
+  {
+    if (id >= body_count_) return Status::invalid_body;
+    const Status s = check_state(position, orientation, Vec::Zero(), Space<D>::zero_spin());
+    if (s != Status::ok) return s;
+    Body<D>& b = bodies_[id];
+    b.position = position;
+    b.orientation = detail::normalized(orientation);
+    wake(b);
+    return Status::ok;
+  }
+
+  /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` if dt
+  /// is not finite and positive; then nothing changes. Overflow of the pair buffer is reported in
+  /// the result, never silent.
+  StepResult step(Scalar dt)
+  {
+    StepResult result;
+    if (!detail::finite(dt) || !(dt > 0)) {
+      result.status = Status::invalid_time_step;
+      return result;
+    }
+    integrate(dt);
+    find_pairs(result);
+    for (std::uint32_t i = 0; i < body_count_; ++i) bodies_[i].touching = false;
+    result.contacts += resolve_planes(Pass::impact);
+    const std::uint32_t touching = resolve_pairs(pair_count_, Pass::impact);
+    result.contacts += touching;
+    // Planes come last in every support pass: a pair push can drive a body into the ground, and
+    // the ground has the last word on position and velocity.
+    for (int i = 0; i < def_.support_iterations; ++i) {
+      resolve_pairs(touching, Pass::support);
+      resolve_planes(Pass::support);
+    }
+    if (def_.shock_propagation) {
+      sort_bottom_up(touching);
+      resolve_pairs(touching, Pass::shock);
+      resolve_planes(Pass::support);
+    }
+    update_motion_states(dt);
+    ++step_count_;
+    return result;
+  }
+
+  std::uint32_t body_count() const { return body_count_; }
+  std::uint32_t plane_count() const { return plane_count_; }
+  std::uint32_t shape_count() const { return shape_count_; }
+  std::uint32_t body_capacity() const { return max_bodies_; }
+  std::uint32_t plane_capacity() const { return max_planes_; }
+  std::uint32_t pair_capacity() const { return max_pairs_; }
+  std::uint32_t shape_capacity() const { return max_shapes_; }
+  std::uint64_t step_count() const { return step_count_; }
+
+  /// A body's state. `id` must be < body_count() (checked by STATSIM_ASSERT).
+  const Body<D>& body(BodyId id) const
+  {
+    STATSIM_ASSERT(id < body_count_);
+    return bodies_[id];
+  }
+  const Plane<D>& plane(PlaneId id) const
+  {
+    STATSIM_ASSERT(id < plane_count_);
+    return planes_[id];
+  }
+  const Shape& shape(ShapeId id) const
+  {
+    STATSIM_ASSERT(id < shape_count_);
+    return shapes_[id];
+  }
+  /// Candidate pairs of the last step (the broad phase's output, up to the pair capacity).
+  const Pair* pairs() const { return pairs_; }
+  std::uint32_t pair_count() const { return pair_count_; }
+
+  /// Number of bodies in each motion state.
+  std::uint32_t count(MotionState s) const
+  {
+    std::uint32_t n = 0;
+    for (std::uint32_t i = 0; i < body_count_; ++i) n += bodies_[i].state == s;
+    return n;
+  }
+
+  /// FNV-1a hash of everything that determines the future: body states, planes, shapes, counts.
+  /// Equal hashes after equal calls show bit-identical worlds.
+  std::uint64_t state_hash() const
+  {
+    detail::Fnv1a h;
+    h.add(body_count_);
+    h.add(plane_count_);
+    h.add(shape_count_);
+    h.add(step_count_);
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      const Body<D>& b = bodies_[i];
+      h.add_vec(b.position);
+      h.add_rot(b.orientation);
+      h.add_vec(b.linear_velocity);
+      h.add_spin(b.angular_velocity);
+      h.add(b.radius);
+      h.add(b.bounding_radius);
+      h.add(b.inv_mass);
+      h.add(b.slow_time);
+      h.add(b.rng_state);
+      h.add(b.shape);
+      h.add(std::uint8_t(b.state));
+      h.add(std::uint8_t(b.touching));
+    }
+    for (std::uint32_t i = 0; i < plane_count_; ++i) {
+      h.add_vec(planes_[i].normal);
+      h.add(planes_[i].offset);
+    }
+    for (std::uint32_t i = 0; i < shape_count_; ++i) {
+      h.add(shapes_[i].radius);
+      h.add(shapes_[i].bounding_radius);
+      h.add(shapes_[i].material.restitution);
+      h.add(shapes_[i].material.friction);
+    }
+    return h.value;
+  }
+
+ protected:
+  /// Storage a `World<>` hands to its core.
+  struct Storage {
+    Body<D>* bodies;
+    SweepEntry* entries;
+    Pair* pairs;
+    Plane<D>* planes;
+    Shape* shapes;
+    std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
+  };
+
+  WorldCore(const Storage& s, const WorldDef<D>& def)
+      : bodies_(s.bodies),
+        entries_(s.entries),
+        pairs_(s.pairs),
+        planes_(s.planes),
+        shapes_(s.shapes),
+        max_bodies_(s.max_bodies),
+        max_pairs_(s.max_pairs),
+        max_planes_(s.max_planes),
+        max_shapes_(s.max_shapes)
+  {
+    construction_status_ = configure(def);
+  }
+  ~WorldCore() = default;
+
+ private:
+  static Status validate(const WorldDef<D>& d)
+  {
+    if (!detail::finite(d.gravity) || !detail::finite(d.restitution_threshold) || !detail::finite(d.settle_speed) ||
+        !detail::finite(d.sleep_speed) || !detail::finite(d.sleep_time) || !detail::finite(d.wake_speed) ||
+        !detail::finite(d.linear_damping) || !detail::finite(d.angular_damping) ||
+        !detail::finite(d.allowed_overlap) || !detail::finite(d.overlap_correction))
+      return Status::non_finite;
+    if (d.restitution_threshold < 0 || d.settle_speed < 0 || d.sleep_speed < 0 || d.sleep_time < 0 ||
+        d.wake_speed < 0 || d.linear_damping < 0 || d.angular_damping < 0 || d.support_iterations < 1 ||
+        d.support_iterations > 64 || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
+        !(d.overlap_correction > 0) || d.overlap_correction > 1 || d.sweep_axis < 0 ||
+        d.sweep_axis >= D)
+      return Status::invalid_parameter;
+    return Status::ok;
+  }
+
+  static Status check_state(const Vec& x, const Rot& q, const Vec& v, const Spin& w)
+  {
+    if (!detail::finite(x) || !detail::finite(q) || !detail::finite(v) || !detail::finite(w))
+      return Status::non_finite;
+    const Scalar n2 = detail::squared_norm(q);
+    if (!(n2 > Scalar(1e-12))) return Status::zero_quaternion;
+    // |q|^2 - 1 ~ 2 (|q| - 1): a tolerance of 1e-3 on the length.
+    if (!(n2 > Scalar(1 - 2e-3) && n2 < Scalar(1 + 2e-3))) return Status::non_unit_quaternion;
+    return Status::ok;
+  }
+
+  void wake(Body<D>& b)
+  {
+    b.state = MotionState::moving;
+    b.slow_time = 0;
+  }
+
+  void integrate(Scalar dt)
+  {
+    const Vec dv = def_.gravity * dt;
+    const Scalar lin_damp = Scalar(1) / (1 + dt * def_.linear_damping);
+    const Scalar ang_damp = Scalar(1) / (1 + dt * def_.angular_damping);
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      Body<D>& b = bodies_[i];
+      if (b.state == MotionState::asleep) continue;
+      b.linear_velocity = (b.linear_velocity + dv) * lin_damp;
+      b.angular_velocity = b.angular_velocity * ang_damp;
+      b.position += b.linear_velocity * dt;
+      b.orientation = detail::integrate(b.orientation, b.angular_velocity, dt);
+    }
+  }
+
+  void find_pairs(StepResult& result)
+  {
+    const int axis = def_.sweep_axis;
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      SweepEntry& e = entries_[i];
+      const Body<D>& b = bodies_[e.body];
+      e.lo = b.position[axis] - b.bounding_radius;
+      e.hi = b.position[axis] + b.bounding_radius;
+    }
+    detail::insertion_sort(entries_, body_count_);
+    std::uint32_t found = 0;
+    detail::sweep(entries_, body_count_, [&](std::uint32_t a, std::uint32_t b) {
+      const Body<D>& ba = bodies_[a];
+      const Body<D>& bb = bodies_[b];
+      if (ba.state == MotionState::asleep && bb.state == MotionState::asleep) return;
+      const Scalar reach = ba.bounding_radius + bb.bounding_radius;
+      if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
+      if (found < max_pairs_) pairs_[found] = a < b ? Pair{a, b} : Pair{b, a};
+      ++found;
+    });
+    result.pairs_found = found;
+    if (found > max_pairs_) {
+      result.pairs_dropped = found - max_pairs_;
+      result.overflow |= overflow_pairs;
+    }
+    pair_count_ = found < max_pairs_ ? found : max_pairs_;
+  }
+
+  /// The first contact pass resolves impacts with the bodies' response; support passes only take
+  /// out what approach velocity is left (inelastic, with friction), so that a stack passes its
+  /// weight down to the ground within one step instead of one layer per step.
+  ///
+  /// The shock pass (Guendelman, Bridson and Fedkiw 2003) then visits contacts from the bottom up
+  /// and treats the lower body of each as immovable: whatever approach velocity and overlap are
+  /// left go to the upper body alone, so a pile is consistent from the ground up after one pass,
+  /// where Gauss-Seidel passes over k layers leave residuals that pump the pile.
+  enum class Pass : std::uint8_t { impact, support, shock };
+
+  /// Plane contacts of every awake body: approaching bodies get the particle response, and a body
+  /// inside a plane is moved out along its normal.
+  std::uint32_t resolve_planes(Pass pass)
+  {
+    const Scalar threshold = pass == Pass::impact ? def_.restitution_threshold : no_bounce;
+    std::uint32_t contacts = 0;
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      Body<D>& b = bodies_[i];
+      if (b.state == MotionState::asleep) continue;
+      for (std::uint32_t p = 0; p < plane_count_; ++p) {
+        Contact<D> c;
+        // A support pass also sees a body that the last pass left exactly touching the plane.
+        const Scalar slop = pass == Pass::impact ? 0 : b.radius * contact_slop;
+        if (!sphere_plane_contact<D>(b.position, b.radius + slop, planes_[p], c)) continue;
+        if (c.depth > slop) b.position += c.normal * (c.depth - slop);
+        b.touching = true;
+        ++contacts;
+        particle_plane_response<D>(b.linear_velocity, b.angular_velocity, b.radius, c.normal,
+                                   shapes_[b.shape].material, threshold);
+      }
+    }
+    return contacts;
+  }
+
+  /// Body-body contacts among the first `count` candidate pairs. The impact pass moves the pairs
+  /// that touch to the front of the buffer and returns how many; support passes run over those.
+  std::uint32_t resolve_pairs(std::uint32_t count, Pass pass)
+  {
+    const Scalar threshold = pass == Pass::impact ? def_.restitution_threshold : no_bounce;
+    const int up = Space<D>::up_axis;
+    std::uint32_t touching = 0;
+    for (std::uint32_t k = 0; k < count; ++k) {
+      Body<D>& a = bodies_[pairs_[k].a];
+      Body<D>& b = bodies_[pairs_[k].b];
+      Contact<D> c;
+      const Scalar slop = pass == Pass::impact ? 0 : (a.radius + b.radius) * contact_slop;
+      if (!sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c)) continue;
+      if (pass == Pass::impact) {
+        const Pair p = pairs_[touching];
+        pairs_[touching] = pairs_[k];
+        pairs_[k] = p;
+      }
+      ++touching;
+      const Vec& n = c.normal;
+      const bool a_asleep = a.state == MotionState::asleep;
+      const bool b_asleep = b.state == MotionState::asleep;
+      if (pass == Pass::impact && (a_asleep || b_asleep)) {
+        // An awake body hitting a sleeper fast enough wakes it; otherwise the sleeper is static.
+        const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(n);
+        if (approach > def_.wake_speed) {
+          if (a_asleep) wake(a);
+          if (b_asleep) wake(b);
+        }
+      }
+      Scalar ima = a.state == MotionState::asleep ? 0 : a.inv_mass;
+      Scalar imb = b.state == MotionState::asleep ? 0 : b.inv_mass;
+      // Shock pass: a contact that mostly supports (normal within 60 degrees of up) freezes its
+      // lower body; the normal points from a to b, so n_up > 0 means a is below.
+      if (pass == Pass::shock && n[up] >= Scalar(0.5) && imb > 0) ima = 0;
+      if (pass == Pass::shock && n[up] <= Scalar(-0.5) && ima > 0) imb = 0;
+      const Scalar ims = ima + imb;
+      if (ims <= 0) continue;
+      particle_response<D>({a.linear_velocity, a.angular_velocity, ima, a.radius},
+                           {b.linear_velocity, b.angular_velocity, imb, b.radius}, n,
+                           mix(shapes_[a.shape].material, shapes_[b.shape].material), threshold);
+      // Positions are corrected once per step (in the shock pass, or the impact pass without
+      // one), softly: pushing every overlap apart in full lifts a pile a little each step
+      // (sideways pushes in a packed pile squeeze bodies upwards) and the lift comes back as
+      // kinetic energy, so the pile never sleeps. Split in proportion to inverse mass, so a
+      // sleeper (0) does not move.
+      const bool correct = pass == (def_.shock_propagation ? Pass::shock : Pass::impact);
+      const Scalar depth = (c.depth - slop - def_.allowed_overlap * (a.radius + b.radius)) * def_.overlap_correction;
+      if (correct && depth > 0) {
+        a.position -= n * (depth * ima / ims);
+        b.position += n * (depth * imb / ims);
+      }
+      a.touching = true;
+      b.touching = true;
+    }
+    return touching;
+  }
+
+  /// Orders the first `count` pairs by the height of their lower centre, ties by body index, so
+  /// the order is a total one and the same on every platform.
+  void sort_bottom_up(std::uint32_t count)
+  {
+    const int up = Space<D>::up_axis;
+    const Body<D>* bodies = bodies_;
+    std::sort(pairs_, pairs_ + count, [bodies, up](const Pair& x, const Pair& y) {
+      const Scalar xa = bodies[x.a].position[up], xb = bodies[x.b].position[up];
+      const Scalar ya = bodies[y.a].position[up], yb = bodies[y.b].position[up];
+      const Scalar kx = xa < xb ? xa : xb, ky = ya < yb ? ya : yb;
+      if (kx != ky) return kx < ky;
+      if (x.a != y.a) return x.a < y.a;
+      return x.b < y.b;
+    });
+  }
+
+  void update_motion_states(Scalar dt)
+  {
+    const Scalar settle2 = def_.settle_speed * def_.settle_speed;
+    const Scalar sleep2 = def_.sleep_speed * def_.sleep_speed;
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      Body<D>& b = bodies_[i];
+      if (b.state == MotionState::asleep) continue;
+      const Scalar r2 = b.bounding_radius * b.bounding_radius;
+      const Scalar v2 = b.linear_velocity.squaredNorm();
+      const Scalar w2 = detail::squared_norm(b.angular_velocity) * r2;
+      const Scalar speed2 = v2 > w2 ? v2 : w2;
+      if (!b.touching || speed2 >= settle2) {
+        b.state = MotionState::moving;
+        b.slow_time = 0;
+        continue;
+      }
+      b.state = MotionState::settling;
+      b.slow_time = speed2 < sleep2 ? b.slow_time + dt : 0;
+      if (speed2 < sleep2 && b.slow_time >= def_.sleep_time) {
+        b.state = MotionState::asleep;
+        b.linear_velocity = Vec::Zero();
+        b.angular_velocity = Space<D>::zero_spin();
+      }
+    }
+  }
+
+  /// Approach speed used as restitution threshold in support passes: nothing bounces there.
+  static constexpr Scalar no_bounce = std::numeric_limits<Scalar>::infinity();
+  /// Support passes count spheres within this fraction of their radius as touching: the impact
+  /// pass leaves resting contacts exactly touching, not overlapping.
+  static constexpr Scalar contact_slop = Scalar(1e-3);
+
+  Body<D>* bodies_;
+  SweepEntry* entries_;
+  Pair* pairs_;
+  Plane<D>* planes_;
+  Shape* shapes_;
+  std::uint32_t max_bodies_, max_pairs_, max_planes_, max_shapes_;
+  std::uint32_t body_count_ = 0, pair_count_ = 0, plane_count_ = 0, shape_count_ = 0;
+  std::uint64_t step_count_ = 0;
+  WorldDef<D> def_{};
+  Status construction_status_ = Status::ok;
+};
+
+namespace detail {
+/// Storage of a World, a base class so that it is constructed before the core that points into it.
+template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes>
+struct WorldStorage {
+  std::array<Body<D>, MaxBodies> body_store;
+  std::array<SweepEntry, MaxBodies> entry_store;
+  std::array<Pair, MaxPairs> pair_store;
+  std::array<Plane<D>, MaxPlanes> plane_store;
+  std::array<Shape, MaxShapes> shape_store;
+};
+}  // namespace detail
+
+/// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
+/// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
+/// `overflow_pairs`)
+/// and `MaxShapes` shapes. All storage is inside the object: a large world belongs in static
+/// storage, not on the stack (10,000 bodies take about 1.5 MB).
+template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
+          std::uint32_t MaxShapes = 8>
+class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>, public WorldCore<D> {
+  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+
+ public:
+  static constexpr std::uint32_t max_bodies = MaxBodies;
+  static constexpr std::uint32_t max_planes = MaxPlanes;
+  static constexpr std::uint32_t max_pairs = MaxPairs;
+  static constexpr std::uint32_t max_shapes = MaxShapes;
+  static_assert(MaxBodies > 0 && MaxPlanes > 0 && MaxPairs > 0 && MaxShapes > 0, "capacities must be positive");
+  static_assert(MaxShapes <= 65535 && MaxPlanes <= 65535, "shape and plane ids are 16-bit");
+
+  /// A world with the given parameters; if they are invalid it uses the defaults and
+  /// `construction_status()` says why.
+  explicit World(const WorldDef<D>& def = {})
+      : StorageBase(),
+        WorldCore<D>(typename WorldCore<D>::Storage{StorageBase::body_store.data(), StorageBase::entry_store.data(),
+                                                     StorageBase::pair_store.data(), StorageBase::plane_store.data(),
+                                                     StorageBase::shape_store.data(), MaxBodies, MaxPairs, MaxPlanes,
+                                                     MaxShapes},
+                     def)
+  {
+  }
+};
+
+}  // namespace statsim

@@ -1,0 +1,149 @@
+#include <doctest/doctest.h>
+
+#include "statsim/world3.hpp"
+#include "statsim/world2.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <utility>
+#include <vector>
+
+using namespace statsim;
+
+namespace {
+
+using PairList = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+PairList sorted(PairList p)
+{
+  for (auto& x : p)
+    if (x.first > x.second) std::swap(x.first, x.second);
+  std::sort(p.begin(), p.end());
+  return p;
+}
+
+struct Sphere {
+  Vector3 c;
+  float r;
+};
+
+PairList brute_force(const std::vector<Sphere>& s)
+{
+  PairList out;
+  for (std::uint32_t i = 0; i < s.size(); ++i)
+    for (std::uint32_t j = i + 1; j < s.size(); ++j) {
+      const float reach = s[i].r + s[j].r;
+      if ((s[i].c - s[j].c).squaredNorm() <= reach * reach) out.emplace_back(i, j);
+    }
+  return out;
+}
+
+PairList sweep_and_prune(std::vector<SweepEntry>& entries, const std::vector<Sphere>& s, int axis)
+{
+  for (auto& e : entries) {
+    e.lo = s[e.body].c[axis] - s[e.body].r;
+    e.hi = s[e.body].c[axis] + s[e.body].r;
+  }
+  detail::insertion_sort(entries.data(), std::uint32_t(entries.size()));
+  for (std::size_t i = 1; i < entries.size(); ++i) REQUIRE(entries[i - 1].lo <= entries[i].lo);
+  PairList out;
+  detail::sweep(entries.data(), std::uint32_t(entries.size()), [&](std::uint32_t a, std::uint32_t b) {
+    const float reach = s[a].r + s[b].r;
+    if ((s[a].c - s[b].c).squaredNorm() <= reach * reach) out.emplace_back(a, b);
+  });
+  return sorted(out);
+}
+
+}  // namespace
+
+TEST_CASE("sweep-and-prune finds exactly the brute-force pairs, also after many incremental steps")
+{
+  Pcg32 rng(11, 0);
+  for (int scene = 0; scene < 8; ++scene) {
+    const int n = 50 + 60 * scene;
+    std::vector<Sphere> s(n);
+    std::vector<Vector3> vel(n);
+    for (int i = 0; i < n; ++i) {
+      s[i].c = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-1, 1));
+      s[i].r = rng.uniform(0.05f, 0.4f);
+      vel[i] = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 0.05f;
+    }
+    std::vector<SweepEntry> entries(n);
+    for (int i = 0; i < n; ++i) entries[i] = SweepEntry{0, 0, std::uint32_t(i)};
+    const int axis = scene % 3;
+    std::size_t total = 0;
+    for (int step = 0; step < 200; ++step) {
+      const PairList got = sweep_and_prune(entries, s, axis);
+      const PairList want = brute_force(s);
+      REQUIRE(got == want);
+      total += want.size();
+      for (int i = 0; i < n; ++i) {
+        s[i].c += vel[i];
+        // Bounce inside the box so the scene keeps mixing.
+        for (int k = 0; k < 3; ++k)
+          if (std::abs(s[i].c[k]) > (k == 2 ? 1.0f : 3.0f)) vel[i][k] = -vel[i][k];
+      }
+    }
+    CHECK(total > 0);  // the scenes do produce pairs
+  }
+}
+
+TEST_CASE("world broad phase: pairs equal brute force on bounding spheres, skipping sleeping pairs")
+{
+  // Collision spheres are tiny, so no contact moves a body and the end-of-step positions are the
+  // positions the broad phase saw.
+  WorldDef3 def;
+  def.gravity = Vector3::Zero();
+  auto world = std::make_unique<World3<400, 8, 4000>>(def);
+  ShapeDef small;
+  small.radius = 1e-4f;
+  small.bounding_radius = 0.3f;
+  const ShapeId shape = world->add_shape(small).id;
+  Pcg32 rng(21, 0);
+  for (int i = 0; i < 400; ++i) {
+    BodyDef3 b;
+    b.shape = shape;
+    b.position = Vector3(rng.uniform(-4, 4), rng.uniform(-4, 4), rng.uniform(-2, 2));
+    b.linear_velocity = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    b.asleep = i % 5 == 0;
+    REQUIRE(world->add_body(b).ok());
+  }
+  for (int step = 0; step < 300; ++step) {
+    const StepResult r = world->step(1.0f / 60);
+    REQUIRE(r.ok());
+    REQUIRE(r.contacts == 0);
+    PairList want;
+    for (std::uint32_t i = 0; i < world->body_count(); ++i)
+      for (std::uint32_t j = i + 1; j < world->body_count(); ++j) {
+        const Body3& a = world->body(i);
+        const Body3& b = world->body(j);
+        if (a.state == MotionState::asleep && b.state == MotionState::asleep) continue;
+        const float reach = a.bounding_radius + b.bounding_radius;
+        if ((a.position - b.position).squaredNorm() <= reach * reach) want.emplace_back(i, j);
+      }
+    PairList got;
+    for (std::uint32_t k = 0; k < world->pair_count(); ++k) got.emplace_back(world->pairs()[k].a, world->pairs()[k].b);
+    REQUIRE(sorted(got) == want);
+    REQUIRE(r.pairs_found == want.size());
+  }
+}
+
+TEST_CASE("pair buffer overflow is reported with the number dropped")
+{
+  World2<20, 2, 10> world;
+  ShapeDef shape;
+  shape.radius = 0.5f;
+  REQUIRE(world.add_shape(shape).ok());
+  for (int i = 0; i < 20; ++i) {
+    BodyDef2 b;
+    b.position = Vector2(0.04f * float(i), 5);  // all within reach of each other: 190 pairs
+    REQUIRE(world.add_body(b).ok());
+  }
+  const StepResult r = world.step(1.0f / 60);
+  CHECK(r.status == Status::ok);
+  CHECK((r.overflow & overflow_pairs) != 0);
+  CHECK(!r.ok());
+  CHECK(r.pairs_found == 190);
+  CHECK(r.pairs_dropped == 180);
+  CHECK(world.pair_count() == 10);
+}

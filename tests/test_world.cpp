@@ -1,0 +1,244 @@
+#include <doctest/doctest.h>
+
+#include "statsim/world2.hpp"
+#include "statsim/world3.hpp"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+using namespace statsim;
+
+namespace {
+constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
+constexpr float inf_f = std::numeric_limits<float>::infinity();
+
+template <class World>
+void fill_scene(World& w, int n, std::uint32_t seed)
+{
+  ShapeDef s;
+  s.radius = 0.1f;
+  s.bounding_radius = 0.12f;
+  REQUIRE(w.add_shape(s).ok());
+  REQUIRE(w.add_plane(World::Vec::Unit(World::Vec::RowsAtCompileTime - 1), 0).ok());
+  Pcg32 g(seed, 0);
+  for (int i = 0; i < n; ++i) {
+    BodyDef<World::Vec::RowsAtCompileTime> b;
+    for (int k = 0; k < b.position.size(); ++k) b.position[k] = g.uniform(-1, 1);
+    b.position[b.position.size() - 1] = g.uniform(0.2f, 3);
+    for (int k = 0; k < b.position.size(); ++k) b.linear_velocity[k] = g.uniform(-2, 2);
+    REQUIRE(w.add_body(b).ok());
+  }
+}
+}  // namespace
+
+TEST_CASE("bad input is rejected with its status and the world is unchanged (3D)")
+{
+  World3<4, 2> w;
+  fill_scene(w, 3, 1);
+  for (int i = 0; i < 10; ++i) w.step(1.0f / 60);
+  const std::uint64_t before = w.state_hash();
+  const std::uint32_t bodies = w.body_count();
+
+  BodyDef3 ok;
+  ok.position = Vector3(0, 0, 1);
+  auto expect_rejected = [&](const BodyDef3& d, Status s) {
+    CHECK(w.add_body(d).status == s);
+    CHECK(w.body_count() == bodies);
+    CHECK(w.state_hash() == before);
+  };
+  BodyDef3 d = ok;
+  d.position.x() = nan_f;
+  expect_rejected(d, Status::non_finite);
+  d = ok;
+  d.position.z() = inf_f;
+  expect_rejected(d, Status::non_finite);
+  d = ok;
+  d.linear_velocity.y() = nan_f;
+  expect_rejected(d, Status::non_finite);
+  d = ok;
+  d.angular_velocity.x() = -inf_f;
+  expect_rejected(d, Status::non_finite);
+  d = ok;
+  d.orientation = Quaternion(0, 0, 0, 0);
+  expect_rejected(d, Status::zero_quaternion);
+  d = ok;
+  d.orientation = Quaternion(2, 0, 0, 0);
+  expect_rejected(d, Status::non_unit_quaternion);
+  d = ok;
+  d.orientation = Quaternion(nan_f, 0, 0, 0);
+  expect_rejected(d, Status::non_finite);
+  d = ok;
+  d.shape = 5;
+  expect_rejected(d, Status::invalid_shape);
+  d = ok;
+  d.mass = 0;
+  expect_rejected(d, Status::invalid_mass);
+  d = ok;
+  d.mass = nan_f;
+  expect_rejected(d, Status::non_finite);
+
+  CHECK(w.step(0).status == Status::invalid_time_step);
+  CHECK(w.step(-1.0f / 60).status == Status::invalid_time_step);
+  CHECK(w.step(nan_f).status == Status::invalid_time_step);
+  CHECK(w.step(inf_f).status == Status::invalid_time_step);
+  CHECK(w.state_hash() == before);
+
+  CHECK(w.add_plane(Vector3::Zero(), 0).status == Status::invalid_plane);
+  CHECK(w.add_plane(Vector3(0, nan_f, 1), 0).status == Status::invalid_plane);
+  CHECK(w.add_plane(Vector3(0, 0, 1), inf_f).status == Status::invalid_plane);
+  CHECK(w.plane_count() == 1);
+
+  ShapeDef bad;
+  bad.radius = -1;
+  CHECK(w.add_shape(bad).status == Status::invalid_radius);
+  bad.radius = 0.2f;
+  bad.bounding_radius = 0.1f;
+  CHECK(w.add_shape(bad).status == Status::invalid_radius);
+  bad.bounding_radius = 0;
+  bad.material.restitution = 1.5f;
+  CHECK(w.add_shape(bad).status == Status::invalid_material);
+  bad.material.restitution = 0.5f;
+  bad.material.friction = nan_f;
+  CHECK(w.add_shape(bad).status == Status::non_finite);
+  CHECK(w.shape_count() == 1);
+
+  CHECK(w.set_velocity(7, Vector3::Zero(), Vector3::Zero()) == Status::invalid_body);
+  CHECK(w.set_velocity(0, Vector3(nan_f, 0, 0), Vector3::Zero()) == Status::non_finite);
+  CHECK(w.set_transform(0, Vector3::Zero(), Quaternion(0, 0, 0, 0)) == Status::zero_quaternion);
+  CHECK(w.state_hash() == before);
+
+  WorldDef3 def = w.def();
+  def.sleep_time = -1;
+  CHECK(w.configure(def) == Status::invalid_parameter);
+  def = w.def();
+  def.gravity.x() = nan_f;
+  CHECK(w.configure(def) == Status::non_finite);
+  def = w.def();
+  def.sweep_axis = 3;
+  CHECK(w.configure(def) == Status::invalid_parameter);
+  CHECK(w.def().sweep_axis == 0);
+
+  // Filling to capacity works; one more is reported, not dropped silently or overwritten.
+  CHECK(w.add_body(ok).ok());
+  CHECK(w.add_body(ok).status == Status::capacity_exceeded);
+  CHECK(w.body_count() == 4);
+  CHECK(w.add_plane(Vector3(1, 0, 0), -5).ok());
+  CHECK(w.add_plane(Vector3(-1, 0, 0), -5).status == Status::capacity_exceeded);
+}
+
+TEST_CASE("bad input is rejected with state unchanged (2D)")
+{
+  World2<2, 1> w;
+  fill_scene(w, 1, 2);
+  w.step(1.0f / 60);
+  const std::uint64_t before = w.state_hash();
+  BodyDef2 d;
+  d.orientation = Rot2{0, 0};
+  CHECK(w.add_body(d).status == Status::zero_quaternion);
+  d.orientation = Rot2{0.5f, 0.5f};
+  CHECK(w.add_body(d).status == Status::non_unit_quaternion);
+  d.orientation = Rot2::from_angle(0.3f);
+  d.angular_velocity = nan_f;
+  CHECK(w.add_body(d).status == Status::non_finite);
+  CHECK(w.add_plane(Vector2(0, 0), 1).status == Status::invalid_plane);
+  CHECK(w.step(-0.1f).status == Status::invalid_time_step);
+  CHECK(w.state_hash() == before);
+  WorldDef2 bad;
+  bad.sweep_axis = 2;
+  World2<2, 1> w2(bad);
+  CHECK(w2.construction_status() == Status::invalid_parameter);
+  CHECK(w2.def().sweep_axis == 0);
+}
+
+TEST_CASE("a body dropped on the ground comes to rest at height r and falls asleep")
+{
+  World3<1, 1> w3;
+  ShapeDef s;
+  s.radius = 0.25f;
+  REQUIRE(w3.add_shape(s).ok());
+  REQUIRE(w3.add_plane(Vector3(0, 0, 1), 0).ok());
+  BodyDef3 b;
+  b.position = Vector3(0.3f, -0.2f, 2);
+  b.linear_velocity = Vector3(0.5f, 0, 0);
+  REQUIRE(w3.add_body(b).ok());
+  int steps = 0;
+  while (w3.body(0).state != MotionState::asleep && steps < 60 * 10) {
+    REQUIRE(w3.step(1.0f / 60).ok());
+    REQUIRE(w3.body(0).position.z() >= 0.25f - 1e-5f);
+    ++steps;
+  }
+  CHECK(w3.body(0).state == MotionState::asleep);
+  CHECK(w3.body(0).position.z() == doctest::Approx(0.25).epsilon(1e-4));
+  CHECK(w3.body(0).linear_velocity.norm() == 0);
+  // Asleep means asleep: more steps change nothing.
+  const Vector3 rest = w3.body(0).position;
+  for (int i = 0; i < 100; ++i) w3.step(1.0f / 60);
+  CHECK(w3.body(0).position == rest);
+
+  World2<1, 1> w2;
+  REQUIRE(w2.add_shape(s).ok());
+  REQUIRE(w2.add_plane(Vector2(0, 1), -1).ok());
+  BodyDef2 b2;
+  b2.position = Vector2(0, 3);
+  b2.angular_velocity = 2;
+  REQUIRE(w2.add_body(b2).ok());
+  for (int i = 0; i < 60 * 10 && w2.body(0).state != MotionState::asleep; ++i) w2.step(1.0f / 60);
+  CHECK(w2.body(0).state == MotionState::asleep);
+  CHECK(w2.body(0).position.y() == doctest::Approx(-0.75).epsilon(1e-4));
+}
+
+TEST_CASE("a fast body hitting a sleeper wakes it; a slow one rests on it")
+{
+  World3<2, 1> w;
+  ShapeDef s;
+  s.radius = 0.5f;
+  REQUIRE(w.add_shape(s).ok());
+  REQUIRE(w.add_plane(Vector3(0, 0, 1), 0).ok());
+  BodyDef3 sleeper;
+  sleeper.position = Vector3(0, 0, 0.5f);
+  sleeper.asleep = true;
+  REQUIRE(w.add_body(sleeper).ok());
+  BodyDef3 faller;
+  faller.position = Vector3(0.3f, 0, 1.6f);
+  faller.linear_velocity = Vector3(0, 0, -3);
+  REQUIRE(w.add_body(faller).ok());
+  for (int i = 0; i < 10; ++i) w.step(1.0f / 60);
+  CHECK(w.body(0).state != MotionState::asleep);
+}
+
+TEST_CASE("two worlds with the same seed stay bit-identical; another seed differs")
+{
+  auto a = std::make_unique<World3<300>>();
+  auto b = std::make_unique<World3<300>>();
+  WorldDef3 other;
+  other.seed = 99;
+  auto c = std::make_unique<World3<300>>(other);
+  fill_scene(*a, 300, 5);
+  fill_scene(*b, 300, 5);
+  fill_scene(*c, 300, 5);
+  for (int i = 0; i < 400; ++i) {
+    a->step(1.0f / 60);
+    b->step(1.0f / 60);
+    c->step(1.0f / 60);
+    REQUIRE(a->state_hash() == b->state_hash());
+  }
+  CHECK(a->state_hash() != c->state_hash());  // the per-body random streams differ
+  CHECK(a->count(MotionState::asleep) > 0);
+}
+
+TEST_CASE("a pile on the ground settles: nothing below the ground, most bodies asleep")
+{
+  auto w = std::make_unique<World3<500>>();
+  fill_scene(*w, 500, 8);
+  REQUIRE(w->add_plane(Vector3(1, 0, 0), -1.2f).ok());
+  REQUIRE(w->add_plane(Vector3(-1, 0, 0), -1.2f).ok());
+  REQUIRE(w->add_plane(Vector3(0, 1, 0), -1.2f).ok());
+  REQUIRE(w->add_plane(Vector3(0, -1, 0), -1.2f).ok());
+  for (int i = 0; i < 60 * 15; ++i) REQUIRE(w->step(1.0f / 60).ok());
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+    REQUIRE(std::isfinite(w->body(i).position.z()));
+    REQUIRE(w->body(i).position.z() >= 0.1f - 1e-4f);
+  }
+  CHECK(w->count(MotionState::asleep) > 250);
+}

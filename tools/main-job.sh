@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# The main job: runs the demo programs on the committed tables, from a built tree.
+#   tools/main-job.sh [BUILD_DIR]   (default: build)
+set -euo pipefail
+bin="${1:-build}/bin"
+for demo in sphere_pile; do
+  if [ ! -x "$bin/$demo" ]; then
+    echo "main-job.sh: $bin/$demo not found: build first (see README.md)" >&2
+    exit 1
+  fi
+  echo "== $demo"
+  "$bin/$demo"
+done

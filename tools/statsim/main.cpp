@@ -1,0 +1,11 @@
+// The `statsim` host command: one executable, one subcommand per job.
+#include <CLI/CLI.hpp>
+
+int main(int argc, char** argv)
+{
+  CLI::App app{"statsim host tools: reference simulations, signature tables, benchmarks"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "statsim 0.1.0");
+  CLI11_PARSE(app, argc, argv);
+  return 0;
+}
