@@ -56,7 +56,7 @@ PairList sweep_and_prune(std::vector<SweepEntry>& entries, const std::vector<Sph
 
 }  // namespace
 
-TEST_CASE("sweep-and-prune finds exactly the brute-force pairs, also after many incremental steps")
+TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many incremental steps")
 {
   Pcg32 rng(11, 0);
   for (int scene = 0; scene < 8; ++scene) {
@@ -88,7 +88,7 @@ TEST_CASE("sweep-and-prune finds exactly the brute-force pairs, also after many 
   }
 }
 
-TEST_CASE("world broad phase: pairs equal brute force on bounding spheres, skipping sleeping pairs")
+TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skipping sleeping pairs")
 {
   // Collision spheres are tiny, so no contact moves a body and the end-of-step positions are the
   // positions the broad phase saw.

@@ -5,7 +5,7 @@
 
 using namespace statsim;
 
-TEST_CASE("sphere-plane contact: normal is the plane's, depth is the overlap")
+TEST_CASE("sphere-plane contact: normal is the planes - depth is the overlap")
 {
   const Plane<3> ground{Vector3(0, 0, 1), 0};
   Contact<3> c;
@@ -27,7 +27,7 @@ TEST_CASE("sphere-plane contact: normal is the plane's, depth is the overlap")
   CHECK(c2.depth == doctest::Approx(0.5));
 }
 
-TEST_CASE("sphere-sphere contact: normal from a to b on the line of centres, depth is the overlap")
+TEST_CASE("sphere-sphere contact: normal from a to b on the line of centres - depth is the overlap")
 {
   Contact<3> c;
   CHECK(sphere_sphere_contact<3>(Vector3(0, 0, 0), 1, Vector3(1.5f, 0, 0), 1, c));
@@ -103,13 +103,13 @@ void check_energy_never_increases()
 }
 }  // namespace
 
-TEST_CASE("a particle collision never increases kinetic energy (2D and 3D, body-body and body-static)")
+TEST_CASE("a particle collision never increases kinetic energy (2D and 3D - body-body and body-static)")
 {
   check_energy_never_increases<3>();
   check_energy_never_increases<2>();
 }
 
-TEST_CASE("particle response against a plane: restitution on the normal, friction bounded by Coulomb")
+TEST_CASE("particle response against a plane: restitution on the normal - friction bounded by Coulomb")
 {
   Material m;
   m.restitution = 0.5f;

@@ -101,7 +101,7 @@ void populate_and_step(W& w)
 }
 }  // namespace
 
-TEST_CASE("no heap allocation in construction and 10,000 steps of full-capacity worlds, 2D and 3D")
+TEST_CASE("no heap allocation in construction and 10000 steps of full-capacity worlds - 2D and 3D")
 {
   g_allocations = 0;
   // Self-check: the counters do see allocations (volatile, so the compiler cannot elide them).

@@ -6,7 +6,7 @@
 
 using statsim::Pcg32;
 
-TEST_CASE("pcg32: same seed and stream give the same sequence; streams differ")
+TEST_CASE("pcg32: same seed and stream give the same sequence - streams differ")
 {
   Pcg32 a(42, 7), b(42, 7), c(42, 8), d(43, 7);
   int same_c = 0, same_d = 0;
@@ -20,7 +20,7 @@ TEST_CASE("pcg32: same seed and stream give the same sequence; streams differ")
   CHECK(same_d < 3);
 }
 
-TEST_CASE("pcg32: matches the reference implementation's first outputs")
+TEST_CASE("pcg32: matches the reference implementations first outputs")
 {
   // pcg32_srandom_r(&rng, 42u, 54u) from the PCG reference (pcg32-demo): first six outputs.
   Pcg32 g(42, 54);
@@ -36,7 +36,7 @@ TEST_CASE("pcg32: resume continues a saved stream")
   for (int i = 0; i < 10; ++i) CHECK(g.next_u32() == r.next_u32());
 }
 
-TEST_CASE("uniform lies in [0, 1) with mean 1/2")
+TEST_CASE("uniform lies in the unit interval with mean 1/2")
 {
   Pcg32 g(3, 4);
   double sum = 0;
@@ -50,7 +50,7 @@ TEST_CASE("uniform lies in [0, 1) with mean 1/2")
   CHECK(sum / n == doctest::Approx(0.5).epsilon(0.005));
 }
 
-TEST_CASE("gaussian has mean 0, variance 1 and normal tails")
+TEST_CASE("gaussian has mean 0 - variance 1 and normal tails")
 {
   Pcg32 g(5, 6);
   const int n = 400000;

@@ -188,7 +188,7 @@ TEST_CASE("a body dropped on the ground comes to rest at height r and falls asle
   CHECK(w2.body(0).position.y() == doctest::Approx(-0.75).epsilon(1e-4));
 }
 
-TEST_CASE("a fast body hitting a sleeper wakes it; a slow one rests on it")
+TEST_CASE("a fast body hitting a sleeper wakes it - a slow one rests on it")
 {
   World3<2, 1> w;
   ShapeDef s;
@@ -207,7 +207,7 @@ TEST_CASE("a fast body hitting a sleeper wakes it; a slow one rests on it")
   CHECK(w.body(0).state != MotionState::asleep);
 }
 
-TEST_CASE("two worlds with the same seed stay bit-identical; another seed differs")
+TEST_CASE("two worlds with the same seed stay bit-identical - another seed differs")
 {
   auto a = std::make_unique<World3<300>>();
   auto b = std::make_unique<World3<300>>();
@@ -227,7 +227,7 @@ TEST_CASE("two worlds with the same seed stay bit-identical; another seed differ
   CHECK(a->count(MotionState::asleep) > 0);
 }
 
-TEST_CASE("a pile on the ground settles: nothing below the ground, most bodies asleep")
+TEST_CASE("a pile on the ground settles: nothing below the ground - most bodies asleep")
 {
   auto w = std::make_unique<World3<500>>();
   fill_scene(*w, 500, 8);
