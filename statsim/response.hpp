@@ -114,6 +114,26 @@ bool particle_plane_response(typename Space<D>::Vec& velocity, typename Space<D>
                               restitution_threshold);
 }
 
+/// V_particle+ of the statistical response (paper 3.3.2 step 7): the velocity a point particle
+/// would leave a static plane with (unit normal `n`, towards the particle) with. Normal part:
+/// -e v_n (e = 0 below `restitution_threshold` of approach speed). Tangential part: Coulomb
+/// friction over the normal impulse, v_t' = v_t max(0, 1 - mu (1 + e) |v_n| / |v_t|). The
+/// gathering tools compute the same V_particle+ for their offsets V_rigid+ - V_particle+.
+template <int D>
+typename Space<D>::Vec point_particle_velocity(const typename Space<D>::Vec& v, const typename Space<D>::Vec& n,
+                                               const Material& m, Scalar restitution_threshold)
+{
+  using Vec = typename Space<D>::Vec;
+  const Scalar vn = v.dot(n);
+  if (vn >= 0) return v;
+  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
+  const Vec vt = v - n * vn;
+  const Scalar slip = vt.norm();
+  const Scalar cut = m.friction * (1 + e) * -vn;
+  const Scalar keep = slip > cut ? 1 - cut / slip : Scalar(0);
+  return vt * keep - n * (e * vn);
+}
+
 /// Kinetic energy of a solid sphere (or disc in 2D) of mass `mass` and radius `radius`, J.
 template <int D>
 Scalar kinetic_energy(const typename Space<D>::Vec& v, const typename Space<D>::Spin& w, Scalar mass, Scalar radius)

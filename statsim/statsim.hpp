@@ -9,6 +9,8 @@
 #include "statsim/broadphase.hpp"
 #include "statsim/contact.hpp"
 #include "statsim/response.hpp"
+#include "statsim/signature.hpp"
+#include "statsim/statistical.hpp"
 #include "statsim/world.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"

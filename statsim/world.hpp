@@ -23,6 +23,7 @@
 #include "statsim/contact.hpp"
 #include "statsim/random.hpp"
 #include "statsim/response.hpp"
+#include "statsim/statistical.hpp"
 #include "statsim/status.hpp"
 
 #include <algorithm>
@@ -106,6 +107,25 @@ struct WorldDef {
   /// Fraction of the remaining overlap of two bodies removed per step, in (0, 1]. Typical: 0.2
   /// to 0.8; 1 corrects in full, which makes packed piles churn.
   Scalar overlap_correction = Scalar(0.5);
+  /// In the spin ratio that sets the collision radius, speeds below this count as this, m/s, so
+  /// a body resting or bouncing in place keeps a steady radius. Typical: the settle speed.
+  Scalar spin_ratio_speed_floor = Scalar(0.5);
+  /// Collision radius from the nearest height sample instead of interpolating (paper 3.3.1:
+  /// both work).
+  bool nearest_radius = false;
+  /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
+  bool rest_conditions = true;
+  /// Seconds over which a settling body's radius blends from h_coll to h_rest (and back).
+  Scalar rest_blend_time = Scalar(0.15);
+  /// Settling bodies are turned toward their rest pose at each ground contact with an angular
+  /// velocity of (sine of the remaining angle) / rest_turn_time, rad/s. Seconds, > 0.
+  Scalar rest_turn_time = Scalar(0.1);
+  /// A body turning into its rest pose may fall asleep (and snap into the pose) once the pose's
+  /// normal is within this cosine of up (0.996: about 5 degrees).
+  Scalar rest_snap_cosine = Scalar(0.996);
+  /// A plane counts as ground for resting conditions when its normal's up component is at least
+  /// this (0.9: within about 25 degrees of horizontal).
+  Scalar ground_cosine = Scalar(0.9);
   /// Axis the broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
   /// along, not the up axis of a pile.
   int sweep_axis = 0;
@@ -124,10 +144,16 @@ struct Body {
   Scalar inv_mass;                        ///< 1/kg
   Scalar slow_time;                       ///< s spent slow and touching
   std::uint64_t rng_state;                ///< state of the body's PCG32 stream
+  Scalar rest_blend;                      ///< 0: radius is h_coll; 1: radius is h_rest of rest_pose
   ShapeId shape;
   MotionState state;
   bool touching;                          ///< touched a plane or body in the last step
+  bool on_ground;                         ///< touched a near-horizontal plane in the last step
+  std::uint8_t rest_pose;                 ///< chosen rest pose, or `no_rest_pose`
 };
+
+/// `Body::rest_pose` when no rest pose is chosen.
+constexpr std::uint8_t no_rest_pose = 0xff;
 
 /// Result of an `add_*` call: a status and, when ok, the new id.
 template <class Id>
@@ -137,11 +163,16 @@ struct Added {
   constexpr bool ok() const { return status == Status::ok; }
 };
 
-/// Shape data a world keeps.
+/// Shape data a world keeps. A shape with a signature is statistical: its bodies take their
+/// collision radius, response and rest poses from it; without one, bodies are plain spheres with
+/// the particle response.
+template <int D>
 struct Shape {
-  Scalar radius;
-  Scalar bounding_radius;
+  Scalar radius;            ///< m; for statistical shapes the radius at rest (largest h_rest)
+  Scalar bounding_radius;   ///< m
   Material material;
+  bool statistical;
+  SignatureView<D> signature;  ///< meaningful when `statistical`
 };
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
@@ -180,7 +211,28 @@ class WorldCore {
         def.material.rolling_resistance < 0)
       return {Status::invalid_material, 0};
     if (shape_count_ == max_shapes_) return {Status::capacity_exceeded, 0};
-    shapes_[shape_count_] = Shape{def.radius, bound, def.material};
+    shapes_[shape_count_] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}};
+    return {Status::ok, ShapeId(shape_count_++)};
+  }
+
+  /// Registers a statistical shape from its signature (`tables::NAME.view()`). The view is
+  /// copied; the tables it points to must outlive the world (generated tables are static).
+  /// Rejected with `invalid_shape` if the signature is malformed.
+  Added<ShapeId> add_shape(const SignatureView<D>& sig)
+  {
+    const Status s = check_signature(sig);
+    if (s != Status::ok) return {s, 0};
+    if (shape_count_ == max_shapes_) return {Status::capacity_exceeded, 0};
+    // The broad phase must hold every radius a body can take: the largest h_coll and h_rest.
+    Scalar largest = sig.bounding_radius, rest_max = 0;
+    for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i)
+      largest = sig.height.mean[i] > largest ? sig.height.mean[i] : largest;
+    for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+      largest = sig.rest.heights[i] > largest ? sig.rest.heights[i] : largest;
+      rest_max = sig.rest.heights[i] > rest_max ? sig.rest.heights[i] : rest_max;
+    }
+    const Scalar radius = rest_max > 0 ? rest_max : sig.height.mean[0];
+    shapes_[shape_count_] = Shape<D>{radius, largest, sig.material, true, sig};
     return {Status::ok, ShapeId(shape_count_++)};
   }
 
@@ -207,13 +259,15 @@ class WorldCore {
     if (body_count_ == max_bodies_) return {Status::capacity_exceeded, 0};
 
     const BodyId id = body_count_;
-    const Shape& shape = shapes_[def.shape];
+    const Shape<D>& shape = shapes_[def.shape];
     Body<D>& b = bodies_[id];
     b.position = def.position;
     b.orientation = detail::normalized(def.orientation);
     b.linear_velocity = def.asleep ? Vec::Zero() : def.linear_velocity;
     b.angular_velocity = def.asleep ? Space<D>::zero_spin() : def.angular_velocity;
-    b.radius = shape.radius;
+    b.radius = shape.statistical
+                   ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
+                   : shape.radius;
     b.bounding_radius = shape.bounding_radius;
     b.inv_mass = Scalar(1) / def.mass;
     b.slow_time = 0;
@@ -221,6 +275,9 @@ class WorldCore {
     b.shape = def.shape;
     b.state = def.asleep ? MotionState::asleep : MotionState::moving;
     b.touching = false;
+    b.on_ground = false;
+    b.rest_pose = no_rest_pose;
+    b.rest_blend = 0;
     entries_[id] = SweepEntry{0, 0, id};
     ++body_count_;
     return {Status::ok, id};
@@ -262,8 +319,13 @@ class WorldCore {
       return result;
     }
     integrate(dt);
+    update_radii();
     find_pairs(result);
-    for (std::uint32_t i = 0; i < body_count_; ++i) bodies_[i].touching = false;
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      bodies_[i].touching = false;
+      bodies_[i].on_ground = false;
+    }
+    energy_clamps_step_ = 0;
     result.contacts += resolve_planes(Pass::impact);
     const std::uint32_t touching = resolve_pairs(pair_count_, Pass::impact);
     result.contacts += touching;
@@ -279,6 +341,8 @@ class WorldCore {
       resolve_planes(Pass::support);
     }
     update_motion_states(dt);
+    result.energy_clamps = energy_clamps_step_;
+    energy_clamps_ += energy_clamps_step_;
     ++step_count_;
     return result;
   }
@@ -291,6 +355,8 @@ class WorldCore {
   std::uint32_t pair_capacity() const { return max_pairs_; }
   std::uint32_t shape_capacity() const { return max_shapes_; }
   std::uint64_t step_count() const { return step_count_; }
+  /// Sampled responses scaled down by the energy guard, over the world's life.
+  std::uint64_t energy_clamp_count() const { return energy_clamps_; }
 
   /// A body's state. `id` must be < body_count() (checked by STATSIM_ASSERT).
   const Body<D>& body(BodyId id) const
@@ -303,7 +369,7 @@ class WorldCore {
     STATSIM_ASSERT(id < plane_count_);
     return planes_[id];
   }
-  const Shape& shape(ShapeId id) const
+  const Shape<D>& shape(ShapeId id) const
   {
     STATSIM_ASSERT(id < shape_count_);
     return shapes_[id];
@@ -340,9 +406,12 @@ class WorldCore {
       h.add(b.inv_mass);
       h.add(b.slow_time);
       h.add(b.rng_state);
+      h.add(b.rest_blend);
       h.add(b.shape);
       h.add(std::uint8_t(b.state));
       h.add(std::uint8_t(b.touching));
+      h.add(std::uint8_t(b.on_ground));
+      h.add(b.rest_pose);
     }
     for (std::uint32_t i = 0; i < plane_count_; ++i) {
       h.add_vec(planes_[i].normal);
@@ -364,7 +433,7 @@ class WorldCore {
     SweepEntry* entries;
     Pair* pairs;
     Plane<D>* planes;
-    Shape* shapes;
+    Shape<D>* shapes;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   };
 
@@ -389,12 +458,16 @@ class WorldCore {
     if (!detail::finite(d.gravity) || !detail::finite(d.restitution_threshold) || !detail::finite(d.settle_speed) ||
         !detail::finite(d.sleep_speed) || !detail::finite(d.sleep_time) || !detail::finite(d.wake_speed) ||
         !detail::finite(d.linear_damping) || !detail::finite(d.angular_damping) ||
-        !detail::finite(d.allowed_overlap) || !detail::finite(d.overlap_correction))
+        !detail::finite(d.allowed_overlap) || !detail::finite(d.overlap_correction) ||
+        !detail::finite(d.rest_blend_time) || !detail::finite(d.rest_turn_time) || !detail::finite(d.ground_cosine) ||
+        !detail::finite(d.rest_snap_cosine) || !detail::finite(d.spin_ratio_speed_floor))
       return Status::non_finite;
     if (d.restitution_threshold < 0 || d.settle_speed < 0 || d.sleep_speed < 0 || d.sleep_time < 0 ||
         d.wake_speed < 0 || d.linear_damping < 0 || d.angular_damping < 0 || d.support_iterations < 1 ||
         d.support_iterations > 64 || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
-        !(d.overlap_correction > 0) || d.overlap_correction > 1 || d.sweep_axis < 0 ||
+        !(d.overlap_correction > 0) || d.overlap_correction > 1 || !(d.rest_blend_time > 0) ||
+        !(d.rest_turn_time > 0) || d.ground_cosine < 0 || d.ground_cosine > 1 ||
+        d.rest_snap_cosine < 0 || d.rest_snap_cosine > 1 || d.spin_ratio_speed_floor < 0 || d.sweep_axis < 0 ||
         d.sweep_axis >= D)
       return Status::invalid_parameter;
     return Status::ok;
@@ -409,6 +482,85 @@ class WorldCore {
     // |q|^2 - 1 ~ 2 (|q| - 1): a tolerance of 1e-3 on the length.
     if (!(n2 > Scalar(1 - 2e-3) && n2 < Scalar(1 + 2e-3))) return Status::non_unit_quaternion;
     return Status::ok;
+  }
+
+  static Status check_signature(const SignatureView<D>& sig)
+  {
+    if (!detail::finite(sig.length) || !detail::finite(sig.bounding_radius)) return Status::non_finite;
+    if (!(sig.length > 0) || !(sig.bounding_radius > 0)) return Status::invalid_radius;
+    if (sig.material.restitution < 0 || sig.material.restitution > 1 || sig.material.friction < 0)
+      return Status::invalid_material;
+    const ResponseTableView& r = sig.response;
+    const std::uint32_t expected_axes =
+        (D == 3 ? 3u : 2u) + (sig.layout == ResponseLayout::with_speed ? 1u : 0u);
+    if (!sig.height.spin_ratio.values || sig.height.spin_ratio.size < 1 || r.axis_count != expected_axes ||
+        r.components != (D == 3 ? 6u : 3u) || (!r.mean.f32 && !r.mean.i16) || (!r.stddev.f32 && !r.stddev.i16) ||
+        (sig.rest.count > 0 && (!sig.rest.normals || !sig.rest.heights)) || sig.rest.count >= no_rest_pose)
+      return Status::invalid_shape;
+    for (std::uint32_t a = 0; a < r.axis_count; ++a)
+      if (!r.axes[a].values || r.axes[a].size < 1) return Status::invalid_shape;
+    return Status::ok;
+  }
+
+  Pcg32 rng_of(const Body<D>& b) const
+  {
+    return Pcg32::resume(b.rng_state, body_stream(def_.seed, std::uint32_t(&b - bodies_)));
+  }
+
+  /// Collision radius of statistical bodies (paper 3.3.1), blended toward the rest height of a
+  /// chosen rest pose (paper 3.4).
+  void update_radii()
+  {
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      Body<D>& b = bodies_[i];
+      const Shape<D>& shape = shapes_[b.shape];
+      if (!shape.statistical || b.state == MotionState::asleep) continue;
+      const SignatureView<D>& sig = shape.signature;
+      // Spin ratio with the speed floored: a body bouncing in place has |v| near 0 one step and
+      // g dt the next, and |w| L / |v| would swing its radius between the table's ends.
+      const Scalar speed = b.linear_velocity.norm();
+      const Scalar floor = def_.spin_ratio_speed_floor;
+      const Vec v_ref = speed < floor ? Vec(Vec::Unit(0) * floor) : Vec(b.linear_velocity);
+      const Scalar r = collision_radius<D>(sig, v_ref, b.angular_velocity, def_.nearest_radius);
+      if (b.rest_pose == no_rest_pose) {
+        b.radius = r;
+        continue;
+      }
+      const Scalar h = sig.rest.heights[b.rest_pose];
+      const Scalar blended = r + (h - r) * b.rest_blend;
+      // On the ground the sphere changes size about its lowest point, so a body blending to its
+      // rest height settles smoothly instead of dropping (paper 3.4).
+      if (b.on_ground) b.position[Space<D>::up_axis] += blended - b.radius;
+      b.radius = blended;
+    }
+  }
+
+  /// The response of one body alone against a plane with normal `n` (towards the body), with
+  /// its velocity taken relative to `other_velocity`: the statistical response for statistical
+  /// shapes (paper 3.3.2; for body-body contacts each body responds on its own, as in the
+  /// paper), the rest turn for bodies settling on the ground (paper 3.4), else (plain spheres,
+  /// and resting contacts of statistical bodies) the particle response against a static plane.
+  void respond_alone(Body<D>& b, const Vec& n, const Vec& other_velocity, bool ground_contact)
+  {
+    const Shape<D>& shape = shapes_[b.shape];
+    Vec v = b.linear_velocity - other_velocity;
+    // A contact approaching slower than the restitution threshold is resting, not a collision:
+    // the tables describe collisions, and sampling a fresh spin at every resting step would
+    // keep a body from ever settling. It gets the inelastic particle response instead.
+    const bool resting = -v.dot(n) <= def_.restitution_threshold;
+    if (!shape.statistical || (resting && !(ground_contact && b.rest_pose != no_rest_pose))) {
+      particle_plane_response<D>(v, b.angular_velocity, b.radius, n, shape.material, def_.restitution_threshold);
+    } else if (ground_contact && b.rest_pose != no_rest_pose) {
+      if (!(v.dot(n) < 0)) return;
+      v = point_particle_velocity<D>(v, n, shape.material, def_.restitution_threshold);
+      b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, def_.rest_turn_time);
+    } else {
+      Pcg32 rng = rng_of(b);
+      const ResponseOutcome o = statistical_response<D>(shape.signature, b.orientation, n, v, b.angular_velocity, rng);
+      b.rng_state = rng.state();
+      energy_clamps_step_ += o.energy_clamped;
+    }
+    b.linear_velocity = v + other_velocity;
   }
 
   void wake(Body<D>& b)
@@ -486,9 +638,14 @@ class WorldCore {
         if (!sphere_plane_contact<D>(b.position, b.radius + slop, planes_[p], c)) continue;
         if (c.depth > slop) b.position += c.normal * (c.depth - slop);
         b.touching = true;
+        const bool ground = c.normal[Space<D>::up_axis] >= def_.ground_cosine;
+        b.on_ground = b.on_ground || ground;
         ++contacts;
-        particle_plane_response<D>(b.linear_velocity, b.angular_velocity, b.radius, c.normal,
-                                   shapes_[b.shape].material, threshold);
+        if (pass == Pass::impact && shapes_[b.shape].statistical)
+          respond_alone(b, c.normal, Vec::Zero(), ground);
+        else
+          particle_plane_response<D>(b.linear_velocity, b.angular_velocity, b.radius, c.normal,
+                                     shapes_[b.shape].material, threshold);
       }
     }
     return contacts;
@@ -532,9 +689,18 @@ class WorldCore {
       if (pass == Pass::shock && n[up] <= Scalar(-0.5) && ima > 0) imb = 0;
       const Scalar ims = ima + imb;
       if (ims <= 0) continue;
-      particle_response<D>({a.linear_velocity, a.angular_velocity, ima, a.radius},
-                           {b.linear_velocity, b.angular_velocity, imb, b.radius}, n,
-                           mix(shapes_[a.shape].material, shapes_[b.shape].material), threshold);
+      if (pass == Pass::impact && (shapes_[a.shape].statistical || shapes_[b.shape].statistical)) {
+        // Paper 3.3.2: each body responds on its own to the separating plane, with its velocity
+        // relative to the other's (from before either response). A sleeper (or static side)
+        // keeps still.
+        const Vec va = a.linear_velocity, vb = b.linear_velocity;
+        if (ima > 0) respond_alone(a, -n, vb, false);
+        if (imb > 0) respond_alone(b, n, va, false);
+      } else {
+        particle_response<D>({a.linear_velocity, a.angular_velocity, ima, a.radius},
+                             {b.linear_velocity, b.angular_velocity, imb, b.radius}, n,
+                             mix(shapes_[a.shape].material, shapes_[b.shape].material), threshold);
+      }
       // Positions are corrected once per step (in the shock pass, or the impact pass without
       // one), softly: pushing every overlap apart in full lifts a pile a little each step
       // (sideways pushes in a packed pile squeeze bodies upwards) and the lift comes back as
@@ -568,6 +734,33 @@ class WorldCore {
     });
   }
 
+  /// Resting conditions (paper 3.4): a statistical body settling on the ground picks the rest
+  /// pose nearest to its orientation and blends its radius toward that pose's height; a body
+  /// that speeds up again blends back and forgets the pose; a body briefly off the ground keeps
+  /// it.
+  void update_rest_pose(Body<D>& b, bool settling_on_ground, bool fast, Scalar dt)
+  {
+    const Shape<D>& shape = shapes_[b.shape];
+    if (!shape.statistical || !def_.rest_conditions || shape.signature.rest.count == 0) return;
+    const Scalar step = dt / def_.rest_blend_time;
+    if (settling_on_ground) {
+      if (b.rest_pose == no_rest_pose)
+        b.rest_pose = std::uint8_t(nearest_rest_pose<D>(shape.signature, b.orientation, Vec::Unit(Space<D>::up_axis)));
+      b.rest_blend = b.rest_blend + step < 1 ? b.rest_blend + step : Scalar(1);
+    } else if (fast && b.rest_pose != no_rest_pose) {
+      b.rest_blend = b.rest_blend - step > 0 ? b.rest_blend - step : Scalar(0);
+      if (b.rest_blend == 0) b.rest_pose = no_rest_pose;
+    }
+  }
+
+  /// True when the chosen rest pose's normal is within `rest_snap_cosine` of up.
+  bool in_rest_pose(const Body<D>& b) const
+  {
+    const SignatureView<D>& sig = shapes_[b.shape].signature;
+    const Vec u = b.orientation * sig.rest.normal(b.rest_pose);
+    return u[Space<D>::up_axis] >= def_.rest_snap_cosine;
+  }
+
   void update_motion_states(Scalar dt)
   {
     const Scalar settle2 = def_.settle_speed * def_.settle_speed;
@@ -577,19 +770,36 @@ class WorldCore {
       if (b.state == MotionState::asleep) continue;
       const Scalar r2 = b.bounding_radius * b.bounding_radius;
       const Scalar v2 = b.linear_velocity.squaredNorm();
-      const Scalar w2 = detail::squared_norm(b.angular_velocity) * r2;
+      // A body turning into its rest pose spins because the resting conditions make it: its
+      // spin does not count against settling, and it sleeps once the pose is (nearly) reached.
+      const bool turning = b.rest_pose != no_rest_pose;
+      const Scalar w2 = turning ? Scalar(0) : detail::squared_norm(b.angular_velocity) * r2;
       const Scalar speed2 = v2 > w2 ? v2 : w2;
-      if (!b.touching || speed2 >= settle2) {
+      const bool settling = b.touching && speed2 < settle2;
+      update_rest_pose(b, settling && b.on_ground, speed2 >= settle2, dt);
+      if (!settling) {
         b.state = MotionState::moving;
         b.slow_time = 0;
         continue;
       }
       b.state = MotionState::settling;
-      b.slow_time = speed2 < sleep2 ? b.slow_time + dt : 0;
-      if (speed2 < sleep2 && b.slow_time >= def_.sleep_time) {
+      const bool still = speed2 < sleep2 && (!turning || in_rest_pose(b));
+      b.slow_time = still ? b.slow_time + dt : 0;
+      if (still && b.slow_time >= def_.sleep_time) {
         b.state = MotionState::asleep;
         b.linear_velocity = Vec::Zero();
         b.angular_velocity = Space<D>::zero_spin();
+        if (b.rest_pose != no_rest_pose && b.on_ground) {
+          // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
+          // the radius blend are below what a slow body would show.
+          const SignatureView<D>& sig = shapes_[b.shape].signature;
+          const Vec up = Vec::Unit(Space<D>::up_axis);
+          b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), up);
+          const Scalar h = sig.rest.heights[b.rest_pose];
+          b.position[Space<D>::up_axis] += h - b.radius;
+          b.radius = h;
+          b.rest_blend = 1;
+        }
       }
     }
   }
@@ -604,10 +814,12 @@ class WorldCore {
   SweepEntry* entries_;
   Pair* pairs_;
   Plane<D>* planes_;
-  Shape* shapes_;
+  Shape<D>* shapes_;
   std::uint32_t max_bodies_, max_pairs_, max_planes_, max_shapes_;
   std::uint32_t body_count_ = 0, pair_count_ = 0, plane_count_ = 0, shape_count_ = 0;
   std::uint64_t step_count_ = 0;
+  std::uint64_t energy_clamps_ = 0;
+  std::uint32_t energy_clamps_step_ = 0;
   WorldDef<D> def_{};
   Status construction_status_ = Status::ok;
 };
@@ -620,7 +832,7 @@ struct WorldStorage {
   std::array<SweepEntry, MaxBodies> entry_store;
   std::array<Pair, MaxPairs> pair_store;
   std::array<Plane<D>, MaxPlanes> plane_store;
-  std::array<Shape, MaxShapes> shape_store;
+  std::array<Shape<D>, MaxShapes> shape_store;
 };
 }  // namespace detail
 

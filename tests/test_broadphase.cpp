@@ -59,7 +59,7 @@ PairList sweep_and_prune(std::vector<SweepEntry>& entries, const std::vector<Sph
 TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many incremental steps")
 {
   Pcg32 rng(11, 0);
-  for (int scene = 0; scene < 8; ++scene) {
+  for (int scene = 0; scene < 6; ++scene) {
     const int n = 50 + 60 * scene;
     std::vector<Sphere> s(n);
     std::vector<Vector3> vel(n);
@@ -72,7 +72,7 @@ TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many
     for (int i = 0; i < n; ++i) entries[i] = SweepEntry{0, 0, std::uint32_t(i)};
     const int axis = scene % 3;
     std::size_t total = 0;
-    for (int step = 0; step < 200; ++step) {
+    for (int step = 0; step < 80; ++step) {
       const PairList got = sweep_and_prune(entries, s, axis);
       const PairList want = brute_force(s);
       REQUIRE(got == want);
@@ -108,7 +108,7 @@ TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skip
     b.asleep = i % 5 == 0;
     REQUIRE(world->add_body(b).ok());
   }
-  for (int step = 0; step < 300; ++step) {
+  for (int step = 0; step < 120; ++step) {
     const StepResult r = world->step(1.0f / 60);
     REQUIRE(r.ok());
     REQUIRE(r.contacts == 0);

@@ -72,7 +72,7 @@ void check_energy_never_increases()
 {
   Pcg32 g(77, D);
   int responded = 0;
-  for (int trial = 0; trial < 20000; ++trial) {
+  for (int trial = 0; trial < 10000; ++trial) {
     typename Space<D>::Vec va = random_vec<D>(g, 5), vb = random_vec<D>(g, 5);
     typename Space<D>::Spin wa = random_spin<D>(g, 30), wb = random_spin<D>(g, 30);
     const float ma = g.uniform(0.1f, 10), mb = trial % 4 == 0 ? 1e30f : g.uniform(0.1f, 10);
@@ -95,11 +95,11 @@ void check_energy_never_increases()
     REQUIRE(after <= before * (1 + 1e-5) + 1e-9);
     if (hit) {
       // After the impulse the bodies no longer approach along the normal.
-      const auto u = (vb + detail::cross(wb, typename Space<D>::Vec(n * -rb))) - (va + detail::cross(wa, typename Space<D>::Vec(n * ra)));
+      const typename Space<D>::Vec u = (vb + detail::cross(wb, typename Space<D>::Vec(n * -rb))) - (va + detail::cross(wa, typename Space<D>::Vec(n * ra)));
       REQUIRE(u.dot(n) >= -1e-4f * (1 + va.norm() + vb.norm()));
     }
   }
-  CHECK(responded > 5000);
+  CHECK(responded > 2500);
 }
 }  // namespace
 

@@ -1,11 +1,14 @@
 // The `statsim` host command: one executable, one subcommand per job.
 #include <CLI/CLI.hpp>
 
+#include "ref2d/ref2d.hpp"
+
 int main(int argc, char** argv)
 {
   CLI::App app{"statsim host tools: reference simulations, signature tables, benchmarks"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "statsim 0.1.0");
+  statsim::tools::register_ref2d_commands(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

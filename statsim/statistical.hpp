@@ -1,0 +1,247 @@
+#pragma once
+/// @file
+/// The statistical collision model of paper 3.3 as pure functions: the collision radius from the
+/// height table, the canonical frame of a contact, the sampled response, and the rest-pose
+/// helpers of paper 3.4. The world calls these; tests call them directly.
+
+#include "statsim/random.hpp"
+#include "statsim/signature.hpp"
+
+namespace statsim {
+
+/// Spin ratio s = |w| L / |v|, clamped to [0, max_ratio]. Never divides by a vanishing |v|:
+/// when |w| L >= max_ratio |v| (which covers |v| = 0 with any spin) the result is max_ratio,
+/// and a body without spin has s = 0.
+template <int D>
+Scalar spin_ratio(const typename Space<D>::Vec& v, const typename Space<D>::Spin& w, Scalar length, Scalar max_ratio)
+{
+  const Scalar spin = std::sqrt(detail::squared_norm(w)) * length;
+  if (!(spin > 0)) return 0;
+  const Scalar speed = v.norm();
+  if (spin >= max_ratio * speed) return max_ratio;
+  return spin / speed;
+}
+
+/// The collision radius of paper 3.3.1: the mean h_coll at the body's spin ratio, interpolated
+/// (or from the nearest sample).
+template <int D>
+Scalar collision_radius(const SignatureView<D>& sig, const typename Space<D>::Vec& v,
+                        const typename Space<D>::Spin& w, bool nearest = false)
+{
+  const AxisView& axis = sig.height.spin_ratio;
+  const Scalar s = spin_ratio<D>(v, w, sig.length, axis.values[axis.size - 1]);
+  return nearest ? sig.height.nearest_at(s) : sig.height.mean_at(s);
+}
+
+/// The canonical frame of a contact (paper Figure 4): `basis` maps canonical coordinates to
+/// world ones. Its last column is the collision normal; its first is the tangential direction of
+/// the velocity, so that V- has a non-negative first coordinate. When the velocity has no
+/// tangential part the first axis follows the spin's tangential part (3D), else a fixed
+/// perpendicular of the normal. In 2D the two possible tangents are mirror images, and
+/// `mirror` (+1 or -1) is the sign by which the spin changes between the frames.
+template <int D>
+struct ContactFrame {
+  Eigen::Matrix<Scalar, D, D> basis;
+  Scalar mirror = 1;
+};
+
+namespace detail {
+/// A unit vector perpendicular to the unit vector n, from the world axis least aligned with it.
+inline Vector3 any_perpendicular(const Vector3& n)
+{
+  const Scalar ax = std::fabs(n.x()), ay = std::fabs(n.y()), az = std::fabs(n.z());
+  const int k = ax <= ay && ax <= az ? 0 : (ay <= az ? 1 : 2);
+  const Vector3 e = Vector3::Unit(k);
+  return (e - n * n.dot(e)).normalized();
+}
+}  // namespace detail
+
+inline ContactFrame<3> contact_frame(const Vector3& n, const Vector3& v, const Vector3& w)
+{
+  const Vector3 t = v - n * v.dot(n);
+  const Scalar tn = t.norm();
+  Vector3 x;
+  if (tn > Scalar(1e-6) * v.norm()) {
+    x = t / tn;
+  } else {
+    const Vector3 wt = w - n * w.dot(n);
+    const Scalar wn = wt.norm();
+    x = wn > Scalar(1e-12) ? Vector3(wt / wn) : detail::any_perpendicular(n);
+  }
+  ContactFrame<3> f;
+  f.basis.col(0) = x;
+  f.basis.col(1) = n.cross(x);
+  f.basis.col(2) = n;
+  return f;
+}
+
+inline ContactFrame<2> contact_frame(const Vector2& n, const Vector2& v, Scalar /*w*/)
+{
+  const Vector2 perp(n.y(), -n.x());  // (perp, n) is a proper rotation
+  ContactFrame<2> f;
+  f.mirror = v.dot(perp) >= 0 ? Scalar(1) : Scalar(-1);
+  f.basis.col(0) = perp * f.mirror;
+  f.basis.col(1) = n;
+  return f;
+}
+
+/// Kinetic energy per unit mass of a body of the signature's shape, J/kg.
+template <int D>
+Scalar kinetic_energy_per_mass(const SignatureView<D>& sig, const typename Space<D>::Rot& orientation,
+                               const typename Space<D>::Vec& v, const typename Space<D>::Spin& w)
+{
+  if constexpr (D == 3) {
+    const Vector3 wb = orientation.conjugate() * w;
+    return Scalar(0.5) * (v.squaredNorm() + sig.unit_inertia[0] * wb.x() * wb.x() +
+                          sig.unit_inertia[1] * wb.y() * wb.y() + sig.unit_inertia[2] * wb.z() * wb.z());
+  } else {
+    (void)orientation;
+    return Scalar(0.5) * (v.squaredNorm() + sig.unit_inertia[0] * w * w);
+  }
+}
+
+/// What `statistical_response` did.
+struct ResponseOutcome {
+  bool applied = false;         ///< the body was approaching and got a new v and w
+  bool energy_clamped = false;  ///< the sample had more kinetic energy than the contact, and was scaled
+};
+
+/// Table coordinates of a contact (paper 3.3.2 step 4), in the order of the table's axes.
+/// `v` is the velocity relative to the collision plane; it must approach it (v.n < 0).
+template <int D>
+std::uint32_t response_coordinates(const SignatureView<D>& sig, const ContactFrame<D>& frame,
+                                   const typename Space<D>::Vec& n, const typename Space<D>::Vec& v,
+                                   const typename Space<D>::Spin& w, Scalar* x)
+{
+  const Scalar speed = v.norm();
+  const Scalar cos_theta = -v.dot(n) / speed;
+  std::uint32_t k = 0;
+  x[k++] = cos_theta;
+  if constexpr (D == 3) {
+    (void)frame;
+    const Scalar wn = w.norm();
+    x[k++] = wn > 0 ? v.dot(w) / (speed * wn) : Scalar(0);
+    if (sig.layout == ResponseLayout::with_speed) x[k++] = speed;
+    x[k++] = wn * sig.length / speed;
+  } else {
+    x[k++] = frame.mirror * w * sig.length / speed;
+    if (sig.layout == ResponseLayout::with_speed) x[k++] = speed;
+  }
+  return k;
+}
+
+/// The statistical response of paper 3.3.2, steps 2 to 8, for one body against a collision
+/// plane with unit normal `n` (pointing towards the body). `v` is the body's velocity relative to
+/// the plane (to the other body, for body-body contacts), `w` its spin; both are replaced.
+/// `orientation` (body to world) is needed only for the energy guard, which scales the sampled
+/// response down when it would leave more kinetic energy than the body brought to the contact.
+/// The normal part of the new velocity is kept non-negative: a sphere that still approached the
+/// plane would collide again at once.
+template <int D>
+ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename Space<D>::Rot& orientation,
+                                     const typename Space<D>::Vec& n, typename Space<D>::Vec& v,
+                                     typename Space<D>::Spin& w, Pcg32& rng)
+{
+  using Vec = typename Space<D>::Vec;
+  using Spin = typename Space<D>::Spin;
+  ResponseOutcome out;
+  const Scalar vn = v.dot(n);
+  if (!(vn < 0)) return out;
+  const Scalar speed = v.norm();
+  const ContactFrame<D> frame = contact_frame(n, v, w);
+
+  Scalar x[max_response_axes];
+  response_coordinates<D>(sig, frame, n, v, w, x);
+  constexpr int C = D == 3 ? 6 : 3;  // spin components, then velocity-offset components
+  Scalar mean[C], stddev[C], sample[C];
+  STATSIM_ASSERT(sig.response.components == std::uint32_t(C));
+  sig.response.lookup(x, mean, stddev);
+  for (int c = 0; c < C; c += 2) {
+    float g0, g1;
+    rng.gaussian_pair(g0, g1);
+    sample[c] = mean[c] + stddev[c] * g0;
+    if (c + 1 < C) sample[c + 1] = mean[c + 1] + stddev[c + 1] * g1;
+  }
+
+  // Back to the world frame and to physical units: W+ = w_c |V-| / L, offset = dv_c |V-|.
+  Spin w_new;
+  Vec offset;
+  if constexpr (D == 3) {
+    w_new = frame.basis * Vector3(sample[0], sample[1], sample[2]) * (speed / sig.length);
+    offset = frame.basis * Vector3(sample[3], sample[4], sample[5]) * speed;
+  } else {
+    w_new = frame.mirror * sample[0] * (speed / sig.length);
+    offset = frame.basis * Vector2(sample[1], sample[2]) * speed;
+  }
+  Vec v_new = point_particle_velocity<D>(v, n, sig.material, sig.restitution_threshold) + offset;
+  const Scalar vn_new = v_new.dot(n);
+  if (vn_new < 0) v_new -= n * vn_new;
+
+  // Energy guard: kinetic energy per unit mass, 1/2 |v|^2 + 1/2 w^T (I/m) w.
+  const Scalar before = kinetic_energy_per_mass<D>(sig, orientation, v, w);
+  const Scalar after = kinetic_energy_per_mass<D>(sig, orientation, v_new, w_new);
+  if (after > before) {
+    const Scalar f = std::sqrt(before / after);
+    v_new *= f;
+    w_new = w_new * f;
+    out.energy_clamped = true;
+  }
+  v = v_new;
+  w = w_new;
+  out.applied = true;
+  return out;
+}
+
+/// The rest pose needing the smallest rotation (paper 3.4): the one whose body-frame normal,
+/// turned into the world, is closest to `up`. Returns `sig.rest.count` when there are none.
+template <int D>
+std::uint32_t nearest_rest_pose(const SignatureView<D>& sig, const typename Space<D>::Rot& orientation,
+                                const typename Space<D>::Vec& up)
+{
+  std::uint32_t best = sig.rest.count;
+  Scalar best_dot = -2;
+  for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+    const Scalar d = (orientation * sig.rest.normal(i)).dot(up);
+    if (d > best_dot) {
+      best_dot = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+/// Angular velocity that turns `rest_normal` (body frame) toward `up` (world) in about
+/// `turn_time` seconds: (u x up) / turn_time with u the rest normal in the world, i.e. the
+/// rotation axis scaled by the sine of the remaining angle (paper 3.4's rotational impulse).
+inline Vector3 rest_turn(const Quaternion& orientation, const Vector3& rest_normal, const Vector3& up, Scalar turn_time)
+{
+  return (orientation * rest_normal).cross(up) / turn_time;
+}
+inline Scalar rest_turn(const Rot2& orientation, const Vector2& rest_normal, const Vector2& up, Scalar turn_time)
+{
+  return detail::moment(Vector2(orientation * rest_normal), up) / turn_time;
+}
+
+/// The orientation turned by the smallest rotation that makes `rest_normal` point exactly `up`.
+inline Quaternion snap_to_rest(const Quaternion& orientation, const Vector3& rest_normal, const Vector3& up)
+{
+  const Vector3 u = orientation * rest_normal;
+  const Scalar c = u.dot(up);
+  Quaternion turn;
+  if (c > Scalar(-0.9999)) {
+    // Half-angle quaternion without trigonometry: (1 + cos a, sin a * axis), normalised.
+    const Vector3 axis = u.cross(up);
+    turn = detail::normalized(Quaternion(1 + c, axis.x(), axis.y(), axis.z()));
+  } else {
+    const Vector3 axis = detail::any_perpendicular(up);
+    turn = Quaternion(0, axis.x(), axis.y(), axis.z());
+  }
+  return detail::normalized(turn * orientation);
+}
+inline Rot2 snap_to_rest(const Rot2& orientation, const Vector2& rest_normal, const Vector2& up)
+{
+  const Vector2 u = orientation * rest_normal;
+  return detail::normalized(Rot2{u.dot(up), detail::moment(u, up)} * orientation);
+}
+
+}  // namespace statsim

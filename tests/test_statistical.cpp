@@ -1,0 +1,204 @@
+#include <doctest/doctest.h>
+
+#include "statsim/statistical.hpp"
+
+#include <cmath>
+#include <vector>
+
+using namespace statsim;
+
+namespace {
+// A small 3D signature (scaled layout: cos theta, cos phi, spin ratio) whose response means are
+// a known linear function of the coordinates, so interpolation can be checked exactly.
+using Sig3 = Signature<3, 3, 3, 2, 3, 1, 1>;
+using Sig2 = Signature<2, 3, 3, 3, 1, 1, 2>;
+
+Scalar linear(std::uint32_t c, Scalar x0, Scalar x1, Scalar x2) { return Scalar(0.01) * Scalar(c + 1) + Scalar(0.02) * x0 - Scalar(0.03) * x1 + Scalar(0.01) * x2; }
+
+Sig3 make_sig3()
+{
+  Sig3 s{};
+  s.name = "test3";
+  s.length = 0.5f;
+  s.bounding_radius = 0.5f;
+  s.mass = 1;
+  s.unit_inertia = {0.1f, 0.1f, 0.1f};
+  s.material = Material{0.3f, 0.2f, 0};
+  s.restitution_threshold = 0.1f;
+  s.layout = ResponseLayout::scaled;
+  s.axis_count = 3;
+  s.height_axis = {0, 1, 4};
+  s.height_mean = {0.3f, 0.4f, 0.45f};
+  s.height_stddev = {0.05f, 0.02f, 0.01f};
+  s.axis0 = {0.1f, 0.5f, 1.0f};
+  s.axis1 = {-1, 1};
+  s.axis2 = {0, 1, 3};
+  s.axis3 = {0};
+  std::uint32_t k = 0;
+  for (Scalar x0 : s.axis0)
+    for (Scalar x1 : s.axis1)
+      for (Scalar x2 : s.axis2)
+        for (std::uint32_t c = 0; c < 6; ++c, ++k) {
+          s.response_mean[k] = linear(c, x0, x1, x2);
+          s.response_stddev[k] = Scalar(0.02) + Scalar(0.005) * Scalar(c);
+        }
+  s.rest_normals = {0, 0, 1};
+  s.rest_heights = {0.25f};
+  s.rest_frequencies = {1};
+  return s;
+}
+}  // namespace
+
+TEST_CASE("axis lookup: interior fractions and clamping at both ends")
+{
+  const Scalar v[] = {0, 1, 4};
+  const AxisView a{v, 3};
+  CHECK(locate(a, -5).index == 0);
+  CHECK(locate(a, -5).t == 0);
+  CHECK(locate(a, 0.25f).index == 0);
+  CHECK(locate(a, 0.25f).t == doctest::Approx(0.25));
+  CHECK(locate(a, 1).index == 1);
+  CHECK(locate(a, 1).t == 0);
+  CHECK(locate(a, 2.5f).t == doctest::Approx(0.5));
+  CHECK(locate(a, 9).index == 1);
+  CHECK(locate(a, 9).t == 1);
+  CHECK(locate(a, std::nanf("")).index == 0);
+}
+
+TEST_CASE("multilinear lookup reproduces a linear function inside the grid and clamps outside")
+{
+  const Sig3 sig = make_sig3();
+  const SignatureView<3> view = sig.view();
+  Scalar mean[6], sd[6];
+  const Scalar x[] = {0.3f, 0.2f, 2.0f};
+  view.response.lookup(x, mean, sd);
+  for (std::uint32_t c = 0; c < 6; ++c) CHECK(mean[c] == doctest::Approx(linear(c, 0.3f, 0.2f, 2.0f)));
+  const Scalar outside[] = {5, -3, 10};
+  view.response.lookup(outside, mean, sd);
+  for (std::uint32_t c = 0; c < 6; ++c) CHECK(mean[c] == doctest::Approx(linear(c, 1, -1, 3)));
+  CHECK(view.height.mean_at(0.5f) == doctest::Approx(0.35));
+  CHECK(view.height.mean_at(100) == doctest::Approx(0.45));
+  CHECK(view.height.nearest_at(0.6f) == doctest::Approx(0.4));
+}
+
+TEST_CASE("spin ratio never divides by a vanishing speed")
+{
+  CHECK(spin_ratio<3>(Vector3::Zero(), Vector3(0, 0, 1), 0.5f, 8) == 8);
+  CHECK(spin_ratio<3>(Vector3::Zero(), Vector3::Zero(), 0.5f, 8) == 0);
+  CHECK(spin_ratio<3>(Vector3(2, 0, 0), Vector3(0, 0, 1), 0.5f, 8) == doctest::Approx(0.25));
+  CHECK(spin_ratio<2>(Vector2(1e-30f, 0), 3.0f, 0.5f, 8) == 8);
+  const Sig3 sig = make_sig3();
+  CHECK(collision_radius<3>(sig.view(), Vector3::Zero(), Vector3::Zero()) == doctest::Approx(0.3));
+  CHECK(collision_radius<3>(sig.view(), Vector3::Zero(), Vector3(1, 0, 0)) == doctest::Approx(0.45));
+}
+
+TEST_CASE("3D frame transforms: sampled responses rotated back match the table cell")
+{
+  const Sig3 sig = make_sig3();
+  const SignatureView<3> view = sig.view();
+  Pcg32 g(123, 0);
+  for (int frame_trial = 0; frame_trial < 4; ++frame_trial) {
+    // A random working frame: random normal, incidence cos 0.5, spin at a chosen angle to v.
+    Vector3 n(g.uniform(-1, 1), g.uniform(-1, 1), g.uniform(-1, 1));
+    n.normalize();
+    const Vector3 x = detail::any_perpendicular(n);
+    const Vector3 y = n.cross(x);
+    const Scalar speed = 2.0f, cos_t = 0.5f, sin_t = std::sqrt(1 - cos_t * cos_t);
+    const Vector3 v = (x * sin_t - n * cos_t) * speed;
+    const Vector3 w = (v.normalized() * 0.6f + y * 0.8f) * (1.0f * speed / view.length);  // cos phi 0.6, s = 1
+    Scalar coords[4];
+    const ContactFrame<3> f = contact_frame(n, v, w);
+    REQUIRE(response_coordinates<3>(view, f, n, v, w, coords) == 3);
+    CHECK(coords[0] == doctest::Approx(0.5));
+    CHECK(coords[1] == doctest::Approx(0.6));
+    CHECK(coords[2] == doctest::Approx(1.0));
+    Scalar mean[6], sd[6];
+    view.response.lookup(coords, mean, sd);
+
+    const Eigen::Matrix3f basis = (Eigen::Matrix3f() << x, y, n).finished();
+    const Vector3 vp = point_particle_velocity<3>(v, n, view.material, view.restitution_threshold);
+    const int samples = 20000;
+    double s1[6] = {}, s2[6] = {};
+    int clamped = 0;
+    for (int i = 0; i < samples; ++i) {
+      Vector3 vv = v, ww = w;
+      const ResponseOutcome o = statistical_response<3>(view, Quaternion::Identity(), n, vv, ww, g);
+      REQUIRE(o.applied);
+      clamped += o.energy_clamped;
+      const Vector3 wc = basis.transpose() * ww * (view.length / speed);
+      const Vector3 dc = basis.transpose() * (vv - vp) / speed;
+      const double c[6] = {wc.x(), wc.y(), wc.z(), dc.x(), dc.y(), dc.z()};
+      for (int k = 0; k < 6; ++k) {
+        s1[k] += c[k];
+        s2[k] += c[k] * c[k];
+      }
+    }
+    CHECK(clamped == 0);
+    for (int k = 0; k < 6; ++k) {
+      const double m = s1[k] / samples, sdev = std::sqrt(s2[k] / samples - m * m);
+      // Standard error of the mean sd/sqrt(n) < 3.2e-4; of the sd about sd/sqrt(2n) < 2.3e-4.
+      CHECK(std::fabs(m - mean[k]) < 5 * sd[k] / std::sqrt(double(samples)));
+      CHECK(std::fabs(sdev - sd[k]) < 5 * sd[k] / std::sqrt(2.0 * samples));
+    }
+  }
+}
+
+TEST_CASE("2D frame transforms: mirrored contacts flip the spin and the tangent")
+{
+  Sig2 s{};
+  s.name = "test2";
+  s.length = 1;
+  s.bounding_radius = 1;
+  s.unit_inertia = {0.2f, 0, 0};
+  s.material = Material{0.3f, 0.2f, 0};
+  s.restitution_threshold = 0.1f;
+  s.axis_count = 2;
+  s.height_axis = {0, 1, 2};
+  s.height_mean = {0.5f, 0.6f, 0.7f};
+  s.height_stddev = {0, 0, 0};
+  s.axis0 = {0, 0.5f, 1};
+  s.axis1 = {-2, 0, 2};
+  s.axis2 = {0};
+  s.axis3 = {0};
+  for (std::uint32_t cell = 0; cell < 9; ++cell) {
+    const Scalar spin = s.axis1[cell % 3];
+    s.response_mean[cell * 3 + 0] = Scalar(0.1) * spin;  // spin keeps its sense, scaled down
+    s.response_mean[cell * 3 + 1] = Scalar(0.05);         // extra tangential speed
+    s.response_mean[cell * 3 + 2] = Scalar(0.02);         // extra normal speed
+  }
+  s.rest_normals = {0, 1, 1, 0};
+  s.rest_heights = {0.5f, 0.5f};
+  s.rest_frequencies = {0.5f, 0.5f};
+  const SignatureView<2> view = s.view();
+  const Vector2 n(0, 1);
+  Pcg32 g(5, 5);
+  // Same contact and its mirror image: moving right spinning clockwise, moving left spinning
+  // counter-clockwise. Zero stddev: the responses are exact mirror images.
+  Vector2 v1(1, -1), v2(-1, -1);
+  Scalar w1 = -1.5f, w2 = 1.5f;
+  REQUIRE(statistical_response<2>(view, Rot2{}, n, v1, w1, g).applied);
+  REQUIRE(statistical_response<2>(view, Rot2{}, n, v2, w2, g).applied);
+  CHECK(v1.x() == doctest::Approx(-v2.x()));
+  CHECK(v1.y() == doctest::Approx(v2.y()));
+  CHECK(w1 == doctest::Approx(-w2));
+  CHECK(w1 < 0);  // the spin kept its sense
+  CHECK(v1.y() > 0);
+}
+
+TEST_CASE("rest poses: nearest pose, turn direction and snap")
+{
+  const Sig3 sig3 = make_sig3();
+  const SignatureView<3> view = sig3.view();
+  const Quaternion tilted(Eigen::AngleAxisf(0.3f, Vector3(1, 0, 0)));
+  CHECK(nearest_rest_pose<3>(view, tilted, Vector3(0, 0, 1)) == 0);
+  const Vector3 turn = rest_turn(tilted, Vector3(0, 0, 1), Vector3(0, 0, 1), 0.1f);
+  CHECK(turn.x() < 0);  // rotate back about -x
+  CHECK(turn.norm() == doctest::Approx(std::sin(0.3) / 0.1).epsilon(1e-4));
+  const Quaternion snapped = snap_to_rest(tilted, Vector3(0, 0, 1), Vector3(0, 0, 1));
+  CHECK((snapped * Vector3(0, 0, 1) - Vector3(0, 0, 1)).norm() < 1e-6f);
+  const Quaternion upside(Eigen::AngleAxisf(3.14159265f, Vector3(0, 1, 0)));
+  CHECK((snap_to_rest(upside, Vector3(0, 0, 1), Vector3(0, 0, 1)) * Vector3(0, 0, 1) - Vector3(0, 0, 1)).norm() < 1e-5f);
+  const Rot2 r = Rot2::from_angle(0.4f);
+  const Rot2 r2 = snap_to_rest(r, Vector2(0, 1), Vector2(0, 1));
+  CHECK((r2 * Vector2(0, 1) - Vector2(0, 1)).norm() < 1e-6f);
+}
