@@ -25,6 +25,7 @@ struct SweepEntry {
   Scalar lo;
   Scalar hi;
   std::uint32_t body;
+  std::uint32_t active;  ///< 1 when awake: pairs of two inactive entries are not wanted
 };
 
 namespace detail {
@@ -56,6 +57,25 @@ void sweep(const SweepEntry* entries, std::uint32_t count, OnOverlap&& overlap)
     const Scalar hi = entries[i].hi;
     const std::uint32_t a = entries[i].body;
     for (std::uint32_t j = i + 1; j < count && entries[j].lo <= hi; ++j) overlap(a, entries[j].body);
+  }
+}
+
+/// Like `sweep`, but only for pairs with at least one active entry, at a cost that grows with
+/// the active entries rather than all of them (a settled pile of sleepers costs nearly nothing).
+/// From each active entry it scans forward as `sweep` does, and backward for inactive entries
+/// whose interval reaches it: sorted by lo, those start no earlier than lo - `max_width`, the
+/// widest interval.
+template <class OnOverlap>
+void sweep_active(const SweepEntry* entries, std::uint32_t count, Scalar max_width, OnOverlap&& overlap)
+{
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (!entries[i].active) continue;
+    const Scalar lo = entries[i].lo, hi = entries[i].hi;
+    const std::uint32_t a = entries[i].body;
+    for (std::uint32_t j = i + 1; j < count && entries[j].lo <= hi; ++j) overlap(a, entries[j].body);
+    const Scalar reach = lo - max_width;
+    for (std::uint32_t j = i; j-- > 0 && entries[j].lo >= reach;)
+      if (!entries[j].active && entries[j].hi >= lo) overlap(entries[j].body, a);
   }
 }
 

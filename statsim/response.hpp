@@ -42,7 +42,9 @@ struct ContactSide {
   typename Space<D>::Vec& velocity;     ///< m/s
   typename Space<D>::Spin& spin;        ///< rad/s
   Scalar inv_mass;                      ///< 1/kg; 0 for a static or sleeping body
-  Scalar radius;                        ///< m, centre to contact point
+  /// m, centre to contact point. 0 makes the side a point particle: its spin takes no part in
+  /// the contact (only rolling resistance slows it).
+  Scalar radius;
 };
 
 /// Resolves the contact of `a` and `b` along the unit normal `n` (pointing from a to b).
@@ -61,6 +63,10 @@ bool particle_response(ContactSide<D> a, ContactSide<D> b, const typename Space<
   const Scalar vn = u.dot(n);
   const Scalar inv_mass_sum = a.inv_mass + b.inv_mass;
   if (vn >= 0 || inv_mass_sum <= 0) return false;
+  // Tangential compliance: an impulse j changes the slip by j (1/m)(1 + 1/k) on a rolling sphere
+  // and by j / m on a point particle.
+  const Scalar compliance = a.inv_mass * (a.radius > 0 ? 1 + inv_k : Scalar(1)) +
+                            b.inv_mass * (b.radius > 0 ? 1 + inv_k : Scalar(1));
 
   const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
   const Scalar jn = -(1 + e) * vn / inv_mass_sum;
@@ -69,7 +75,7 @@ bool particle_response(ContactSide<D> a, ContactSide<D> b, const typename Space<
   const Vec ut = u - n * vn;
   const Scalar slip = ut.norm();
   if (slip > Scalar(0)) {
-    const Scalar jt_stick = slip / (inv_mass_sum * (1 + inv_k));
+    const Scalar jt_stick = slip / compliance;
     const Scalar jt_slide = m.friction * jn;
     const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
     impulse -= ut * (jt / slip);

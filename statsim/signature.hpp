@@ -235,4 +235,66 @@ struct Signature {
   }
 };
 
+/// A signature whose response tables are 16-bit integers (value = offset + scale * q, one
+/// scale and offset per table), for firmware where flash is tight. Everything else as in
+/// `Signature`.
+template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
+          std::uint32_t NR>
+struct SignatureQ16 {
+  static constexpr std::uint32_t components = D == 3 ? 6 : 3;
+  static constexpr std::uint32_t cells = A0 * A1 * A2 * A3;
+  static_assert(NH >= 1 && A0 >= 1 && A1 >= 1 && A2 >= 1 && A3 >= 1, "every axis needs a sample");
+
+  const char* name;
+  Scalar length;
+  Scalar bounding_radius;
+  Scalar mass;
+  std::array<Scalar, 3> unit_inertia;
+  Material material;
+  Scalar restitution_threshold;
+  ResponseLayout layout;
+  std::uint32_t axis_count;
+  std::array<Scalar, NH> height_axis;
+  std::array<Scalar, NH> height_mean;
+  std::array<Scalar, NH> height_stddev;
+  std::array<Scalar, A0> axis0;
+  std::array<Scalar, A1> axis1;
+  std::array<Scalar, A2> axis2;
+  std::array<Scalar, A3> axis3;
+  Scalar mean_scale, mean_offset;
+  std::array<std::int16_t, cells * components> response_mean;
+  Scalar stddev_scale, stddev_offset;
+  std::array<std::int16_t, cells * components> response_stddev;
+  std::array<Scalar, NR * D> rest_normals;
+  std::array<Scalar, NR> rest_heights;
+  std::array<Scalar, NR> rest_frequencies;
+
+  constexpr SignatureView<D> view() const
+  {
+    SignatureView<D> v;
+    v.name = name;
+    v.length = length;
+    v.bounding_radius = bounding_radius;
+    v.mass = mass;
+    v.unit_inertia = unit_inertia;
+    v.material = material;
+    v.restitution_threshold = restitution_threshold;
+    v.layout = layout;
+    v.height.spin_ratio = AxisView{height_axis.data(), NH};
+    v.height.mean.f32 = height_mean.data();
+    v.height.stddev.f32 = height_stddev.data();
+    v.response.axes = {AxisView{axis0.data(), A0}, AxisView{axis1.data(), A1}, AxisView{axis2.data(), A2},
+                       AxisView{axis3.data(), A3}};
+    v.response.axis_count = axis_count;
+    v.response.components = components;
+    v.response.mean = ValuesView{nullptr, response_mean.data(), mean_scale, mean_offset};
+    v.response.stddev = ValuesView{nullptr, response_stddev.data(), stddev_scale, stddev_offset};
+    v.rest.normals = rest_normals.data();
+    v.rest.heights = rest_heights.data();
+    v.rest.frequencies = rest_frequencies.data();
+    v.rest.count = NR;
+    return v;
+  }
+};
+
 }  // namespace statsim

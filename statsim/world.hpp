@@ -72,6 +72,12 @@ struct BodyDef {
   bool asleep = false;                                        ///< start asleep (e.g. a pre-built pile)
 };
 
+/// How a body-body impact with a statistical body is resolved (see `WorldCore::respond_pair`).
+enum class PairResponse : std::uint8_t {
+  independent,  ///< paper 3.3.2: each body as against a fixed plane; energy can grow in piles
+  momentum,     ///< the same samples, combined into one momentum-conserving impulse
+};
+
 /// Parameters of a world. Defaults suit bodies of 5 cm to 1 m at 30 to 240 Hz.
 template <int D>
 struct WorldDef {
@@ -102,17 +108,22 @@ struct WorldDef {
   /// After the support passes, one bottom-up pass that settles stacks exactly (see `step`).
   bool shock_propagation = true;
   /// Overlap of two bodies left uncorrected, as a fraction of the sum of their radii, in [0, 0.5).
-  /// Typical: 0.01 to 0.05. Resting contacts keep about this much overlap.
-  Scalar allowed_overlap = Scalar(0.02);
-  /// Fraction of the remaining overlap of two bodies removed per step, in (0, 1]. Typical: 0.2
-  /// to 0.8; 1 corrects in full, which makes packed piles churn.
-  Scalar overlap_correction = Scalar(0.5);
+  /// Typical: 0.005 to 0.05. Resting contacts keep about this much overlap.
+  Scalar allowed_overlap = Scalar(0.01);
+  /// Fraction of the remaining overlap of two bodies removed per step, in (0, 1]. Overlaps are
+  /// corrected in the shock pass only, bottom-up with the lower body fixed, where removing them in
+  /// full lifts nothing that was not sinking; lower values leave piles more compressed.
+  Scalar overlap_correction = Scalar(1);
   /// In the spin ratio that sets the collision radius, speeds below this count as this, m/s, so
   /// a body resting or bouncing in place keeps a steady radius. Typical: the settle speed.
   Scalar spin_ratio_speed_floor = Scalar(0.5);
   /// Collision radius from the nearest height sample instead of interpolating (paper 3.3.1:
   /// both work).
   bool nearest_radius = false;
+  /// Body-body impacts of statistical bodies: the paper's independent responses, or the same
+  /// samples made to conserve momentum (the default: in piles the independent responses add
+  /// energy, see README).
+  PairResponse pair_response = PairResponse::momentum;
   /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
   bool rest_conditions = true;
   /// Seconds over which a settling body's radius blends from h_coll to h_rest (and back).
@@ -278,7 +289,7 @@ class WorldCore {
     b.on_ground = false;
     b.rest_pose = no_rest_pose;
     b.rest_blend = 0;
-    entries_[id] = SweepEntry{0, 0, id};
+    entries_[id] = SweepEntry{0, 0, id, 1};
     ++body_count_;
     return {Status::ok, id};
   }
@@ -502,6 +513,11 @@ class WorldCore {
     return Status::ok;
   }
 
+  /// Lever arm of a body in the particle response: its radius for a sphere; 0 for a statistical
+  /// body, whose sphere is not its shape, so friction on the sphere must not spin it (a spin it
+  /// does not have would come back as speed).
+  Scalar contact_radius(const Body<D>& b) const { return shapes_[b.shape].statistical ? Scalar(0) : b.radius; }
+
   Pcg32 rng_of(const Body<D>& b) const
   {
     return Pcg32::resume(b.rng_state, body_stream(def_.seed, std::uint32_t(&b - bodies_)));
@@ -549,7 +565,8 @@ class WorldCore {
     // keep a body from ever settling. It gets the inelastic particle response instead.
     const bool resting = -v.dot(n) <= def_.restitution_threshold;
     if (!shape.statistical || (resting && !(ground_contact && b.rest_pose != no_rest_pose))) {
-      particle_plane_response<D>(v, b.angular_velocity, b.radius, n, shape.material, def_.restitution_threshold);
+      particle_plane_response<D>(v, b.angular_velocity, contact_radius(b), n, shape.material,
+                                 def_.restitution_threshold);
     } else if (ground_contact && b.rest_pose != no_rest_pose) {
       if (!(v.dot(n) < 0)) return;
       v = point_particle_velocity<D>(v, n, shape.material, def_.restitution_threshold);
@@ -561,6 +578,28 @@ class WorldCore {
       energy_clamps_step_ += o.energy_clamped;
     }
     b.linear_velocity = v + other_velocity;
+  }
+
+  /// Body-body impact with at least one statistical body. Each body first responds on its own
+  /// to the separating plane with its velocity relative to the other's (paper 3.3.2), from the
+  /// velocities before either response; a sleeper (inverse mass 0) keeps still.
+  /// `PairResponse::independent` keeps those velocities, as the paper does. With
+  /// `PairResponse::momentum` the two changes of relative velocity are averaged into one impulse
+  /// that each body takes in proportion to its inverse mass, so momentum is conserved and the
+  /// pair's kinetic energy in its centre-of-mass frame cannot grow; spins stay as sampled.
+  void respond_pair(Body<D>& a, Body<D>& b, const Vec& n, Scalar ima, Scalar imb)
+  {
+    const Vec va = a.linear_velocity, vb = b.linear_velocity;
+    if (ima > 0) respond_alone(a, -n, vb, false);
+    if (imb > 0) respond_alone(b, n, va, false);
+    if (def_.pair_response != PairResponse::momentum) return;
+    // Change of (vb - va) as each body saw it; a static side saw none, so the other counts alone.
+    const Vec from_b = (b.linear_velocity - va) - (vb - va);
+    const Vec from_a = (vb - a.linear_velocity) - (vb - va);
+    const Vec change = ima > 0 && imb > 0 ? Vec((from_a + from_b) * Scalar(0.5)) : (ima > 0 ? from_a : from_b);
+    const Scalar ims = ima + imb;
+    a.linear_velocity = va - change * (ima / ims);
+    b.linear_velocity = vb + change * (imb / ims);
   }
 
   void wake(Body<D>& b)
@@ -587,18 +626,20 @@ class WorldCore {
   void find_pairs(StepResult& result)
   {
     const int axis = def_.sweep_axis;
+    Scalar widest = 0;
     for (std::uint32_t i = 0; i < body_count_; ++i) {
       SweepEntry& e = entries_[i];
       const Body<D>& b = bodies_[e.body];
       e.lo = b.position[axis] - b.bounding_radius;
       e.hi = b.position[axis] + b.bounding_radius;
+      e.active = b.state != MotionState::asleep ? 1u : 0u;
+      widest = 2 * b.bounding_radius > widest ? 2 * b.bounding_radius : widest;
     }
     detail::insertion_sort(entries_, body_count_);
     std::uint32_t found = 0;
-    detail::sweep(entries_, body_count_, [&](std::uint32_t a, std::uint32_t b) {
+    detail::sweep_active(entries_, body_count_, widest, [&](std::uint32_t a, std::uint32_t b) {
       const Body<D>& ba = bodies_[a];
       const Body<D>& bb = bodies_[b];
-      if (ba.state == MotionState::asleep && bb.state == MotionState::asleep) return;
       const Scalar reach = ba.bounding_radius + bb.bounding_radius;
       if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
       if (found < max_pairs_) pairs_[found] = a < b ? Pair{a, b} : Pair{b, a};
@@ -644,7 +685,7 @@ class WorldCore {
         if (pass == Pass::impact && shapes_[b.shape].statistical)
           respond_alone(b, c.normal, Vec::Zero(), ground);
         else
-          particle_plane_response<D>(b.linear_velocity, b.angular_velocity, b.radius, c.normal,
+          particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(b), c.normal,
                                      shapes_[b.shape].material, threshold);
       }
     }
@@ -690,22 +731,17 @@ class WorldCore {
       const Scalar ims = ima + imb;
       if (ims <= 0) continue;
       if (pass == Pass::impact && (shapes_[a.shape].statistical || shapes_[b.shape].statistical)) {
-        // Paper 3.3.2: each body responds on its own to the separating plane, with its velocity
-        // relative to the other's (from before either response). A sleeper (or static side)
-        // keeps still.
-        const Vec va = a.linear_velocity, vb = b.linear_velocity;
-        if (ima > 0) respond_alone(a, -n, vb, false);
-        if (imb > 0) respond_alone(b, n, va, false);
+        respond_pair(a, b, n, ima, imb);
       } else {
-        particle_response<D>({a.linear_velocity, a.angular_velocity, ima, a.radius},
-                             {b.linear_velocity, b.angular_velocity, imb, b.radius}, n,
+        particle_response<D>({a.linear_velocity, a.angular_velocity, ima, contact_radius(a)},
+                             {b.linear_velocity, b.angular_velocity, imb, contact_radius(b)}, n,
                              mix(shapes_[a.shape].material, shapes_[b.shape].material), threshold);
       }
-      // Positions are corrected once per step (in the shock pass, or the impact pass without
-      // one), softly: pushing every overlap apart in full lifts a pile a little each step
-      // (sideways pushes in a packed pile squeeze bodies upwards) and the lift comes back as
-      // kinetic energy, so the pile never sleeps. Split in proportion to inverse mass, so a
-      // sleeper (0) does not move.
+      // Positions are corrected once per step: in the shock pass, or in the impact pass without
+      // one. Pushing overlaps apart in every pass, split between both bodies, squeezes bodies
+      // sideways and upward out of a packed pile each step, and the lift comes back as kinetic
+      // energy, so the pile never sleeps. Split in proportion to inverse mass (in the shock pass
+      // the lower body's is 0), so a sleeper does not move.
       const bool correct = pass == (def_.shock_propagation ? Pass::shock : Pass::impact);
       const Scalar depth = (c.depth - slop - def_.allowed_overlap * (a.radius + b.radius)) * def_.overlap_correction;
       if (correct && depth > 0) {

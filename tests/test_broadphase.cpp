@@ -69,7 +69,7 @@ TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many
       vel[i] = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 0.05f;
     }
     std::vector<SweepEntry> entries(n);
-    for (int i = 0; i < n; ++i) entries[i] = SweepEntry{0, 0, std::uint32_t(i)};
+    for (int i = 0; i < n; ++i) entries[i] = SweepEntry{0, 0, std::uint32_t(i), 1};
     const int axis = scene % 3;
     std::size_t total = 0;
     for (int step = 0; step < 80; ++step) {
@@ -85,6 +85,37 @@ TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many
       }
     }
     CHECK(total > 0);  // the scenes do produce pairs
+  }
+}
+
+TEST_CASE("sweep over active entries finds exactly the pairs with an active member")
+{
+  Pcg32 rng(12, 0);
+  for (int scene = 0; scene < 6; ++scene) {
+    const int n = 100 + 80 * scene;
+    std::vector<Sphere> s(n);
+    std::vector<SweepEntry> entries(n);
+    std::vector<bool> active(n);
+    float widest = 0;
+    for (int i = 0; i < n; ++i) {
+      s[i].c = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), 0);
+      s[i].r = rng.uniform(0.05f, 0.4f);
+      widest = std::max(widest, 2 * s[i].r);
+      active[i] = rng.uniform() < 0.2f * float(scene);
+      entries[i] = SweepEntry{s[i].c.x() - s[i].r, s[i].c.x() + s[i].r, std::uint32_t(i), active[i] ? 1u : 0u};
+    }
+    detail::insertion_sort(entries.data(), std::uint32_t(n));
+    PairList got;
+    detail::sweep_active(entries.data(), std::uint32_t(n), widest, [&](std::uint32_t a, std::uint32_t b) {
+      const float reach = s[a].r + s[b].r;
+      if ((s[a].c - s[b].c).squaredNorm() <= reach * reach) got.emplace_back(a, b);
+    });
+    PairList want;
+    for (const auto& p : brute_force(s))
+      if (active[p.first] || active[p.second]) want.push_back(p);
+    const PairList sorted_got = sorted(got);
+    REQUIRE(sorted_got == want);
+    REQUIRE(std::adjacent_find(sorted_got.begin(), sorted_got.end()) == sorted_got.end());  // no pair twice
   }
 }
 

@@ -6,6 +6,8 @@
 // EIGEN_RUNTIME_NO_MALLOC, so any Eigen heap allocation asserts while it is disallowed.
 #include <doctest/doctest.h>
 
+#include "synthetic_signature.hpp"
+
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 
@@ -71,13 +73,14 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 using namespace statsim;
 
 namespace {
-constexpr std::uint32_t N3 = 512, N2 = 512;
+constexpr std::uint32_t N3 = 512, N2 = 512, N_big = 10000;
 // Static storage: a full-capacity world is big, and constructing it in place is part of the test.
 alignas(World3<N3>) unsigned char storage3[sizeof(World3<N3>)];
 alignas(World2<N2>) unsigned char storage2[sizeof(World2<N2>)];
+alignas(World3<N_big>) unsigned char storage_big[sizeof(World3<N_big>)];
 
 template <int D, class W>
-void populate_and_step(W& w)
+void populate_and_step(W& w, int steps)
 {
   ShapeDef s;
   s.radius = 0.05f;
@@ -97,7 +100,7 @@ void populate_and_step(W& w)
     REQUIRE(w.add_body(b).ok());
   }
   CHECK(w.add_body(BodyDef<D>{}).status == Status::capacity_exceeded);
-  for (int i = 0; i < 10000; ++i) w.step(1.0f / 60);
+  for (int i = 0; i < steps; ++i) w.step(1.0f / 60);
 }
 }  // namespace
 
@@ -117,9 +120,9 @@ TEST_CASE("no heap allocation in construction and 10000 steps of full-capacity w
   Eigen::internal::set_is_malloc_allowed(false);
   g_counting = true;
   auto* w3 = new (storage3) World3<N3>();
-  populate_and_step<3>(*w3);
+  populate_and_step<3>(*w3, 10000);
   auto* w2 = new (storage2) World2<N2>();
-  populate_and_step<2>(*w2);
+  populate_and_step<2>(*w2, 10000);
   g_counting = false;
   Eigen::internal::set_is_malloc_allowed(true);
 
@@ -128,4 +131,27 @@ TEST_CASE("no heap allocation in construction and 10000 steps of full-capacity w
   CHECK(w2->step_count() == 10000);
   std::destroy_at(w3);
   std::destroy_at(w2);
+}
+
+TEST_CASE("no heap allocation in construction and stepping of a 10000-body statistical world")
+{
+  g_allocations = 0;
+  Eigen::internal::set_is_malloc_allowed(false);
+  g_counting = true;
+  auto* w = new (storage_big) World3<N_big>();
+  REQUIRE(w->add_shape(statsim::testing::cube_synthetic.view()).ok());
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+  Pcg32 g(3, 4);
+  for (std::uint32_t i = 0; i < N_big; ++i) {
+    BodyDef3 b;
+    b.position = Vector3(g.uniform(-5, 5), g.uniform(-5, 5), g.uniform(0.2f, 3));
+    b.angular_velocity = Vector3(g.uniform(-5, 5), 0, g.uniform(-5, 5));
+    REQUIRE(w->add_body(b).ok());
+  }
+  for (int i = 0; i < 300; ++i) w->step(1.0f / 60);
+  g_counting = false;
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(g_allocations.load() == 0);
+  CHECK(w->count(MotionState::moving) < N_big);  // bodies did land: contacts were exercised
+  std::destroy_at(w);
 }
