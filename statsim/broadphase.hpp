@@ -10,6 +10,7 @@
 
 #include "statsim/config.hpp"
 
+#include <cmath>
 #include <cstdint>
 
 namespace statsim {
@@ -78,6 +79,77 @@ void sweep_active(const SweepEntry* entries, std::uint32_t count, Scalar max_wid
       if (!entries[j].active && entries[j].hi >= lo) overlap(entries[j].body, a);
   }
 }
+
+}  // namespace detail
+}  // namespace statsim
+
+namespace statsim {
+
+/// Which broad phase a world uses.
+enum class BroadPhase : std::uint8_t {
+  /// Uniform grid of cells one bounding diameter wide, hashed into a fixed table: each awake
+  /// body looks at the 3^D cells around it. Cost grows with awake bodies times their neighbours.
+  grid,
+  /// Sweep-and-prune along one axis (paper 4.1). Cost grows with the bodies whose intervals
+  /// overlap on that axis, which in a wide pile is many more than the true neighbours.
+  sweep_and_prune,
+};
+
+namespace detail {
+
+/// Number of buckets of the grid's hash table for `bodies` bodies: a power of two >= 2 bodies.
+constexpr std::uint32_t grid_buckets(std::uint32_t bodies)
+{
+  std::uint32_t b = 1;
+  while (b < 2 * bodies) b *= 2;
+  return b;
+}
+
+/// Hashed uniform grid over caller-owned arrays: `start` has buckets + 1 entries, `items` one
+/// per body. Built from scratch every step by a counting sort of the bodies by bucket.
+struct SpatialHash {
+  std::uint32_t* start;
+  std::uint32_t* items;
+  std::uint32_t buckets;  ///< a power of two
+  Scalar inv_cell = 1;
+
+  static std::int32_t cell_of(Scalar x, Scalar inv_cell)
+  {
+    Scalar c = std::floor(x * inv_cell);
+    // Clamp so the conversion is defined for bodies far out; cells there merely share buckets.
+    c = c < Scalar(-1e9) ? Scalar(-1e9) : (c > Scalar(1e9) ? Scalar(1e9) : c);
+    return std::int32_t(c);
+  }
+  std::uint32_t bucket(std::int32_t x, std::int32_t y, std::int32_t z) const
+  {
+    const std::uint32_t h = std::uint32_t(x) * 73856093u ^ std::uint32_t(y) * 19349663u ^ std::uint32_t(z) * 83492791u;
+    return h & (buckets - 1);
+  }
+
+  /// Sorts `count` bodies into buckets; `cell(i, c)` writes body i's integer cell coordinates.
+  template <class CellOf>
+  void build(std::uint32_t count, CellOf&& cell)
+  {
+    for (std::uint32_t b = 0; b <= buckets; ++b) start[b] = 0;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      std::int32_t c[3];
+      cell(i, c);
+      ++start[bucket(c[0], c[1], c[2]) + 1];
+    }
+    for (std::uint32_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+    // Fill from the back so each bucket lists its bodies in increasing index order.
+    for (std::uint32_t i = count; i-- > 0;) {
+      std::int32_t c[3];
+      cell(i, c);
+      const std::uint32_t b = bucket(c[0], c[1], c[2]);
+      items[--start[b + 1]] = i;
+    }
+    // The descending fill left start[b + 1] at the first item of bucket b: shift it to start[b],
+    // so that bucket b is items[start[b]] .. items[start[b + 1] - 1].
+    for (std::uint32_t b = 0; b < buckets; ++b) start[b] = start[b + 1];
+    start[buckets] = count;
+  }
+};
 
 }  // namespace detail
 }  // namespace statsim

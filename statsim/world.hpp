@@ -137,7 +137,9 @@ struct WorldDef {
   /// A plane counts as ground for resting conditions when its normal's up component is at least
   /// this (0.9: within about 25 degrees of horizontal).
   Scalar ground_cosine = Scalar(0.9);
-  /// Axis the broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
+  /// The broad phase: a hashed grid (default; it wins in piles) or sweep-and-prune.
+  BroadPhase broad_phase = BroadPhase::grid;
+  /// Axis the sweep-and-prune broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
   /// along, not the up axis of a pile.
   int sweep_axis = 0;
 };
@@ -445,6 +447,8 @@ class WorldCore {
     Pair* pairs;
     Plane<D>* planes;
     Shape<D>* shapes;
+    std::uint32_t* grid_start;
+    std::uint32_t* grid_items;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   };
 
@@ -454,6 +458,7 @@ class WorldCore {
         pairs_(s.pairs),
         planes_(s.planes),
         shapes_(s.shapes),
+        grid_{s.grid_start, s.grid_items, detail::grid_buckets(s.max_bodies)},
         max_bodies_(s.max_bodies),
         max_pairs_(s.max_pairs),
         max_planes_(s.max_planes),
@@ -475,7 +480,8 @@ class WorldCore {
       return Status::non_finite;
     if (d.restitution_threshold < 0 || d.settle_speed < 0 || d.sleep_speed < 0 || d.sleep_time < 0 ||
         d.wake_speed < 0 || d.linear_damping < 0 || d.angular_damping < 0 || d.support_iterations < 1 ||
-        d.support_iterations > 64 || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
+        d.support_iterations > 64 ||
+        (d.broad_phase != BroadPhase::grid && d.broad_phase != BroadPhase::sweep_and_prune) || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
         !(d.overlap_correction > 0) || d.overlap_correction > 1 || !(d.rest_blend_time > 0) ||
         !(d.rest_turn_time > 0) || d.ground_cosine < 0 || d.ground_cosine > 1 ||
         d.rest_snap_cosine < 0 || d.rest_snap_cosine > 1 || d.spin_ratio_speed_floor < 0 || d.sweep_axis < 0 ||
@@ -625,6 +631,66 @@ class WorldCore {
 
   void find_pairs(StepResult& result)
   {
+    if (def_.broad_phase == BroadPhase::grid) find_pairs_grid(result);
+    else find_pairs_sweep(result);
+    const std::uint32_t found = result.pairs_found;
+    if (found > max_pairs_) {
+      result.pairs_dropped = found - max_pairs_;
+      result.overflow |= overflow_pairs;
+    }
+    pair_count_ = found < max_pairs_ ? found : max_pairs_;
+  }
+
+  /// Records a candidate pair if the bounding spheres overlap; counts it either way it fits.
+  void candidate(std::uint32_t a, std::uint32_t b, std::uint32_t& found)
+  {
+    const Body<D>& ba = bodies_[a];
+    const Body<D>& bb = bodies_[b];
+    const Scalar reach = ba.bounding_radius + bb.bounding_radius;
+    if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
+    if (found < max_pairs_) pairs_[found] = a < b ? Pair{a, b} : Pair{b, a};
+    ++found;
+  }
+
+  void find_pairs_grid(StepResult& result)
+  {
+    Scalar widest = 0;
+    for (std::uint32_t i = 0; i < body_count_; ++i)
+      widest = 2 * bodies_[i].bounding_radius > widest ? 2 * bodies_[i].bounding_radius : widest;
+    grid_.inv_cell = Scalar(1) / widest;
+    const auto cell = [this](std::uint32_t i, std::int32_t* c) {
+      for (int k = 0; k < 3; ++k) c[k] = k < D ? grid_.cell_of(bodies_[i].position[k], grid_.inv_cell) : 0;
+    };
+    grid_.build(body_count_, cell);
+    std::uint32_t found = 0;
+    constexpr int neighbours = D == 3 ? 27 : 9;
+    for (std::uint32_t i = 0; i < body_count_; ++i) {
+      if (bodies_[i].state == MotionState::asleep) continue;
+      std::int32_t c[3];
+      cell(i, c);
+      std::uint32_t seen[neighbours];
+      int seen_count = 0;
+      for (int n = 0; n < neighbours; ++n) {
+        const std::int32_t dx = n % 3 - 1, dy = (n / 3) % 3 - 1, dz = D == 3 ? n / 9 - 1 : 0;
+        const std::uint32_t b = grid_.bucket(c[0] + dx, c[1] + dy, c[2] + dz);
+        // Two neighbouring cells can share a bucket: visit each bucket once.
+        bool repeat = false;
+        for (int k = 0; k < seen_count; ++k) repeat = repeat || seen[k] == b;
+        if (repeat) continue;
+        seen[seen_count++] = b;
+        for (std::uint32_t k = grid_.start[b]; k < grid_.start[b + 1]; ++k) {
+          const std::uint32_t j = grid_.items[k];
+          // An awake pair is found once, from its lower index; a sleeper never looks itself.
+          if (j == i || (j < i && bodies_[j].state != MotionState::asleep)) continue;
+          candidate(i, j, found);
+        }
+      }
+    }
+    result.pairs_found = found;
+  }
+
+  void find_pairs_sweep(StepResult& result)
+  {
     const int axis = def_.sweep_axis;
     Scalar widest = 0;
     for (std::uint32_t i = 0; i < body_count_; ++i) {
@@ -637,20 +703,9 @@ class WorldCore {
     }
     detail::insertion_sort(entries_, body_count_);
     std::uint32_t found = 0;
-    detail::sweep_active(entries_, body_count_, widest, [&](std::uint32_t a, std::uint32_t b) {
-      const Body<D>& ba = bodies_[a];
-      const Body<D>& bb = bodies_[b];
-      const Scalar reach = ba.bounding_radius + bb.bounding_radius;
-      if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
-      if (found < max_pairs_) pairs_[found] = a < b ? Pair{a, b} : Pair{b, a};
-      ++found;
-    });
+    detail::sweep_active(entries_, body_count_, widest,
+                         [&](std::uint32_t a, std::uint32_t b) { candidate(a, b, found); });
     result.pairs_found = found;
-    if (found > max_pairs_) {
-      result.pairs_dropped = found - max_pairs_;
-      result.overflow |= overflow_pairs;
-    }
-    pair_count_ = found < max_pairs_ ? found : max_pairs_;
   }
 
   /// The first contact pass resolves impacts with the bodies' response; support passes only take
@@ -851,6 +906,7 @@ class WorldCore {
   Pair* pairs_;
   Plane<D>* planes_;
   Shape<D>* shapes_;
+  detail::SpatialHash grid_;
   std::uint32_t max_bodies_, max_pairs_, max_planes_, max_shapes_;
   std::uint32_t body_count_ = 0, pair_count_ = 0, plane_count_ = 0, shape_count_ = 0;
   std::uint64_t step_count_ = 0;
@@ -869,6 +925,8 @@ struct WorldStorage {
   std::array<Pair, MaxPairs> pair_store;
   std::array<Plane<D>, MaxPlanes> plane_store;
   std::array<Shape<D>, MaxShapes> shape_store;
+  std::array<std::uint32_t, detail::grid_buckets(MaxBodies) + 1> grid_start_store;
+  std::array<std::uint32_t, MaxBodies> grid_item_store;
 };
 }  // namespace detail
 
@@ -896,7 +954,9 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
       : StorageBase(),
         WorldCore<D>(typename WorldCore<D>::Storage{StorageBase::body_store.data(), StorageBase::entry_store.data(),
                                                      StorageBase::pair_store.data(), StorageBase::plane_store.data(),
-                                                     StorageBase::shape_store.data(), MaxBodies, MaxPairs, MaxPlanes,
+                                                     StorageBase::shape_store.data(),
+                                                     StorageBase::grid_start_store.data(),
+                                                     StorageBase::grid_item_store.data(), MaxBodies, MaxPairs, MaxPlanes,
                                                      MaxShapes},
                      def)
   {

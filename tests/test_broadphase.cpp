@@ -123,8 +123,11 @@ TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skip
 {
   // Collision spheres are tiny, so no contact moves a body and the end-of-step positions are the
   // positions the broad phase saw.
+  for (BroadPhase bp : {BroadPhase::grid, BroadPhase::sweep_and_prune}) {
+  CAPTURE(int(bp));
   WorldDef3 def;
   def.gravity = Vector3::Zero();
+  def.broad_phase = bp;
   auto world = std::make_unique<World3<400, 8, 4000>>(def);
   ShapeDef small;
   small.radius = 1e-4f;
@@ -156,6 +159,7 @@ TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skip
     for (std::uint32_t k = 0; k < world->pair_count(); ++k) got.emplace_back(world->pairs()[k].a, world->pairs()[k].b);
     REQUIRE(sorted(got) == want);
     REQUIRE(r.pairs_found == want.size());
+  }
   }
 }
 

@@ -148,7 +148,7 @@ TEST_CASE("no heap allocation in construction and stepping of a 10000-body stati
     b.angular_velocity = Vector3(g.uniform(-5, 5), 0, g.uniform(-5, 5));
     REQUIRE(w->add_body(b).ok());
   }
-  for (int i = 0; i < 300; ++i) w->step(1.0f / 60);
+  for (int i = 0; i < 150; ++i) w->step(1.0f / 60);
   g_counting = false;
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(g_allocations.load() == 0);

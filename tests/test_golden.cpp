@@ -1,0 +1,70 @@
+// Golden hashes: the final state of a fixed scene, bit for bit. A change to the runtime that
+// changes results (on purpose or not) fails here; update the constant in the same commit and
+// say why in its message. The same values hold for Release and for the Debug sanitizer build
+// (the runtime's arithmetic does not depend on the optimisation level).
+#include <doctest/doctest.h>
+
+#include "synthetic_signature.hpp"
+
+#include "statsim/world2.hpp"
+#include "statsim/world3.hpp"
+
+#include <cstdio>
+#include <memory>
+
+using namespace statsim;
+
+namespace {
+template <int D, class World, class Sig>
+std::uint64_t run_scene(World& w, const Sig& sig)
+{
+  const ShapeId stat = w.add_shape(sig.view()).id;
+  ShapeDef ball;
+  ball.radius = 0.12f;
+  const ShapeId sphere = w.add_shape(ball).id;
+  using Vec = typename Space<D>::Vec;
+  w.add_plane(Vec::Unit(Space<D>::up_axis), 0);
+  w.add_plane(Vec::Unit(0), -2);
+  w.add_plane(-Vec::Unit(0), -2);
+  Pcg32 g(2026, 11);
+  for (int i = 0; i < 150; ++i) {
+    BodyDef<D> b;
+    b.shape = i % 3 == 0 ? sphere : stat;
+    for (int k = 0; k < D; ++k) {
+      const float x = g.uniform(-1.5f, 1.5f);
+      b.position[k] = x;
+    }
+    const float h = g.uniform(0.3f, 4);
+    b.position[Space<D>::up_axis] = h;
+    for (int k = 0; k < D; ++k) {
+      const float v = g.uniform(-1, 1);
+      b.linear_velocity[k] = v;
+    }
+    if constexpr (D == 3) {
+      const float wx = g.uniform(-6, 6), wy = g.uniform(-6, 6), wz = g.uniform(-6, 6);
+      b.angular_velocity = Vector3(wx, wy, wz);
+    } else {
+      b.angular_velocity = g.uniform(-6, 6);
+    }
+    REQUIRE(w.add_body(b).ok());
+  }
+  for (int i = 0; i < 600; ++i) REQUIRE(w.step(1.0f / 60).status == Status::ok);
+  return w.state_hash();
+}
+}  // namespace
+
+TEST_CASE("golden hash of a fixed 3D scene")
+{
+  auto w = std::make_unique<World3<150>>();
+  const std::uint64_t h = run_scene<3>(*w, statsim::testing::cube_synthetic);
+  std::printf("golden 3D: 0x%016llx\n", static_cast<unsigned long long>(h));
+  CHECK(h == 0xecdd3664a45cae74ull);
+}
+
+TEST_CASE("golden hash of a fixed 2D scene")
+{
+  auto w = std::make_unique<World2<150>>();
+  const std::uint64_t h = run_scene<2>(*w, statsim::testing::square2d_synthetic);
+  std::printf("golden 2D: 0x%016llx\n", static_cast<unsigned long long>(h));
+  CHECK(h == 0x5cc333f362726783ull);
+}
