@@ -73,7 +73,7 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 using namespace statsim;
 
 namespace {
-constexpr std::uint32_t N3 = 512, N2 = 512, N_big = 10000;
+constexpr std::uint32_t N3 = 128, N2 = 128, N_big = 10000;
 // Static storage: a full-capacity world is big, and constructing it in place is part of the test.
 alignas(World3<N3>) unsigned char storage3[sizeof(World3<N3>)];
 alignas(World2<N2>) unsigned char storage2[sizeof(World2<N2>)];
