@@ -1,6 +1,7 @@
 // The `statsim` host command: one executable, one subcommand per job.
 #include <CLI/CLI.hpp>
 
+#include "mesh/mesh_commands.hpp"
 #include "ref2d/ref2d.hpp"
 
 int main(int argc, char** argv)
@@ -8,6 +9,7 @@ int main(int argc, char** argv)
   CLI::App app{"statsim host tools: reference simulations, signature tables, benchmarks"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "statsim 0.1.0");
+  statsim::tools::register_mesh_commands(app);
   statsim::tools::register_ref2d_commands(app);
   CLI11_PARSE(app, argc, argv);
   return 0;

@@ -1,0 +1,38 @@
+#pragma once
+/// @file
+/// The `statsim mesh ...` subcommands. Each command is also a function returning the exit code
+/// (0 on success), so tests can call it directly; errors go to `err` as one line, and a command
+/// that fails leaves no output file (outputs are written to a temporary file, then renamed).
+
+#include <array>
+#include <iosfwd>
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace statsim::tools {
+
+/// Adds `mesh` with `info`, `decimate`, `spheres`, `box` and `lshape` to the statsim command.
+void register_mesh_commands(CLI::App& app);
+
+/// `mesh info FILE.obj [--density RHO]`: counts, volume, mass, centre of mass, inertia, principal
+/// moments and axes, bounding radius.
+int mesh_info(const std::string& file, double density, std::ostream& out, std::ostream& err);
+
+/// `mesh decimate --in A.obj --out B.obj --vertices N`.
+int mesh_decimate(const std::string& in, const std::string& out_file, int vertices, std::ostream& out,
+                  std::ostream& err);
+
+/// `mesh spheres --in A.obj --count K --out F.txt [--resolution R]`.
+int mesh_spheres(const std::string& in, const std::string& out_file, int count, int resolution, std::ostream& out,
+                 std::ostream& err);
+
+/// `mesh box --size X,Y,Z --out F.obj`.
+int mesh_box(const std::array<double, 3>& size, const std::string& out_file, std::ostream& out, std::ostream& err);
+
+/// `mesh lshape --out F.obj` (the fixed dimensions of shapes.hpp).
+int mesh_lshape(const std::string& out_file, std::ostream& out, std::ostream& err);
+
+}  // namespace statsim::tools

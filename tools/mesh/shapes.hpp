@@ -1,0 +1,36 @@
+#pragma once
+/// @file
+/// The analytic shapes of the signature tables: the box and the paper's L-shape.
+///
+/// The paper does not give the L-shape's dimensions. Ours is an L profile extruded 0.05 m: a
+/// 0.20 x 0.05 x 0.05 m bar (the foot, along x) with a 0.05 x 0.10 x 0.05 m bar standing on one
+/// end of it (the upright, along y), so the L is 0.20 m wide and 0.15 m tall, 0.05 m thick
+/// everywhere. It is placed with its centre of mass at the origin (the foot has twice the upright's
+/// volume). In Bullet it is a btCompoundShape of the two boxes `lshape_boxes()`.
+
+#include "mesh/mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+
+namespace statsim::tools {
+
+/// A box of a compound: its centre and half extents (axis-aligned in the shape's frame).
+struct BoxPart {
+  Eigen::Vector3d centre;
+  Eigen::Vector3d half_extents;
+};
+
+/// The L-shape's two boxes: the foot (centre (0.025, -0.025, 0), half extents (0.1, 0.025,
+/// 0.025)) and the upright (centre (-0.05, 0.05, 0), half extents (0.025, 0.05, 0.025)), metres.
+std::array<BoxPart, 2> lshape_boxes();
+
+/// A closed box of the given full size centred at the origin: 8 vertices, 12 triangles.
+TriMesh make_box(const Eigen::Vector3d& size);
+
+/// The L-shape as one closed surface (the two boxes' union, without the shared face): the L
+/// profile in the xy plane extruded along z; 12 vertices, 20 triangles.
+TriMesh make_lshape();
+
+}  // namespace statsim::tools
