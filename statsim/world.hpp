@@ -129,7 +129,8 @@ struct WorldDef {
   /// Seconds over which a settling body's radius blends from h_coll to h_rest (and back).
   Scalar rest_blend_time = Scalar(0.15);
   /// Settling bodies are turned toward their rest pose at each ground contact with an angular
-  /// velocity of (sine of the remaining angle) / rest_turn_time, rad/s. Seconds, > 0.
+  /// velocity of (sine of the remaining angle) / rest_turn_time, rad/s, capped so that the
+  /// farthest point moves at most at `settle_speed`. Seconds, > 0.
   Scalar rest_turn_time = Scalar(0.1);
   /// A body turning into its rest pose may fall asleep (and snap into the pose) once the pose's
   /// normal is within this cosine of up (0.996: about 5 degrees).
@@ -577,6 +578,11 @@ class WorldCore {
       if (!(v.dot(n) < 0)) return;
       v = point_particle_velocity<D>(v, n, shape.material, def_.restitution_threshold);
       b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, def_.rest_turn_time);
+      // A small turn (paper 3.4): its farthest point moves at most at the settle speed, so a
+      // slow body is not spun up (sin(angle) / rest_turn_time alone reaches 10 rad/s).
+      const Scalar cap = def_.settle_speed / b.bounding_radius;
+      const Scalar spin2 = detail::squared_norm(b.angular_velocity);
+      if (spin2 > cap * cap) b.angular_velocity = b.angular_velocity * (cap / std::sqrt(spin2));
     } else {
       Pcg32 rng = rng_of(b);
       const ResponseOutcome o = statistical_response<D>(shape.signature, b.orientation, n, v, b.angular_velocity, rng);

@@ -3,11 +3,15 @@
 #   tools/main-job.sh [BUILD_DIR]   (default: build)
 set -euo pipefail
 bin="${1:-build}/bin"
-for demo in sphere_pile; do
+out="${1:-build}"
+run() {
+  local demo="$1"; shift
   if [ ! -x "$bin/$demo" ]; then
     echo "main-job.sh: $bin/$demo not found: build first (see README.md)" >&2
     exit 1
   fi
-  echo "== $demo"
-  "$bin/$demo"
-done
+  echo "== $demo $*"
+  "$bin/$demo" "$@"
+}
+run sphere_pile
+run drop2d --png "$out/drop2d.png"

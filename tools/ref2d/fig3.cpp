@@ -32,12 +32,16 @@
 // not at all, when the corner dips through the line and out again between steps. The exact free
 // flight from the initial state catches those, and is also used to check the refinement (they
 // agree to Box2D's float32 rounding). The run's summary counts all of these cases.
+//
+// The drop and the refinement live in box2d_util.cpp (measure_first_contact, for any polygon
+// body), shared with `statsim gather2d`'s collision-height table.
 #include "ref2d/fig3.hpp"
 
 #include "common/atomic_file.hpp"
 #include "common/chart.hpp"
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
+#include "ref2d/box2d_util.hpp"
 
 #include <box2d/box2d.h>
 
@@ -59,117 +63,9 @@ constexpr double kPi = 3.14159265358979323846;
 // Start clearance above the highest possible first-contact height: Box2D's fat-AABB margin, so
 // the drop begins with no pair in the broad phase and takes several free steps.
 constexpr double kClearance = 0.1;
-constexpr int kMaxSteps = 1000000;
 
-// ---- random numbers: a per-trial std::mt19937_64, seeded from (seed, ratio index, trial) ------
-std::uint64_t mix64(std::uint64_t x)
-{
-  // splitmix64 finaliser
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-double uniform01(std::mt19937_64& rng)
-{
-  // 53 random bits; std::uniform_real_distribution is not specified bit-for-bit across libraries.
-  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
-
-// ---- the free motion and the core square ------------------------------------------------------
-struct State {
-  double cx = 0.0;
-  double cy = 0.0;
-  double angle = 0.0;
-  double vx = 0.0;
-  double vy = 0.0;
-  double w = 0.0;
-};
-
-struct Vertex {
-  double x;
-  double y;
-};
-
-State read_state(const b2Body* body)
-{
-  const b2Vec2 c = body->GetWorldCenter();
-  const b2Vec2 v = body->GetLinearVelocity();
-  return {c.x, c.y, body->GetAngle(), v.x, v.y, body->GetAngularVelocity()};
-}
-
-// Height of the lowest core vertex above the line at time t of free flight from s.
-double core_gap(const State& s, const std::vector<Vertex>& verts, double t)
-{
-  const double a = s.angle + s.w * t;
-  const double sn = std::sin(a);
-  const double cs = std::cos(a);
-  double lowest = std::numeric_limits<double>::infinity();
-  for (const Vertex& p : verts) {
-    lowest = std::min(lowest, sn * p.x + cs * p.y);
-  }
-  return s.cy + s.vy * t + lowest;
-}
-
-// Earliest t in [0, t_max] with core_gap(s, t) <= 0, if any (see the comment at the top).
-std::optional<double> first_contact_time(const State& s, const std::vector<Vertex>& verts, double t_max)
-{
-  double r_max = 0.0;
-  for (const Vertex& p : verts) {
-    r_max = std::max(r_max, std::hypot(p.x, p.y));
-  }
-  // Lipschitz bound of core_gap in t, slightly inflated against rounding.
-  const double lipschitz = (std::fabs(s.vy) + std::fabs(s.w) * r_max) * (1.0 + 1e-9) + 1e-300;
-  // Steps never shrink below the time to move 1e-10 m: a dip shallower than that could be missed,
-  // which is far below Box2D's float32 resolution of the state.
-  const double min_step = 1e-10 / lipschitz;
-  double t = 0.0;
-  double g = core_gap(s, verts, 0.0);
-  if (g <= 0.0) {
-    return 0.0;
-  }
-  for (long it = 0; it < 100000000L; ++it) {
-    double next = t + std::max(g / lipschitz, min_step);
-    if (next > t_max) {
-      next = t_max;
-    }
-    const double g_next = core_gap(s, verts, next);
-    if (g_next <= 0.0) {
-      double lo = t;
-      double hi = next;
-      for (int k = 0; k < 200; ++k) {
-        const double mid = 0.5 * (lo + hi);
-        if (!(mid > lo && mid < hi)) {
-          break;
-        }
-        (core_gap(s, verts, mid) <= 0.0 ? hi : lo) = mid;
-      }
-      return hi;
-    }
-    if (next >= t_max) {
-      return std::nullopt;
-    }
-    t = next;
-    g = g_next;
-  }
-  throw std::runtime_error("fig3: first-contact search did not converge");
-}
-
-double wrap_angle(double a)
-{
-  return std::remainder(a, 2.0 * kPi);
-}
-
-bool touching_ground(b2Body* body)
-{
-  for (b2ContactEdge* e = body->GetContactList(); e != nullptr; e = e->next) {
-    if (e->contact->IsTouching()) {
-      return true;
-    }
-  }
-  return false;
-}
+// Random numbers (mix64, uniform01), the free motion and the exact first contact of the core
+// square (measure_first_contact) are shared with `statsim gather2d`: see box2d_util.hpp.
 
 std::string fixed(double v, int decimals)
 {
@@ -258,112 +154,24 @@ Fig3Drop fig3_drop(const Fig3Options& options, double ratio, std::size_t ratio_i
 
 Fig3Trial simulate_fig3_drop(const Fig3Drop& drop, double speed, double dt)
 {
-  b2World world(b2Vec2(0.0f, 0.0f));
-  world.SetAllowSleeping(false);
-
-  b2BodyDef ground_def;
-  b2Body* ground = world.CreateBody(&ground_def);
-  b2EdgeShape line;
-  line.SetTwoSided(b2Vec2(-20.0f, 0.0f), b2Vec2(20.0f, 0.0f));
-  ground->CreateFixture(&line, 0.0f);
-
-  b2BodyDef def;
-  def.type = b2_dynamicBody;
-  def.position.Set(0.0f, static_cast<float>(drop.height));
-  def.angle = static_cast<float>(drop.angle);
-  def.linearVelocity.Set(0.0f, static_cast<float>(-speed));
-  def.angularVelocity = static_cast<float>(drop.spin);
-  def.linearDamping = 0.0f;
-  def.angularDamping = 0.0f;
-  def.allowSleep = false;
-  b2Body* box = world.CreateBody(&def);
   b2PolygonShape square;
   square.SetAsBox(0.5f, 0.5f);
-  b2FixtureDef fixture;
-  fixture.shape = &square;
-  fixture.density = 1.0f;
-  fixture.friction = 0.0f;
-  fixture.restitution = 0.0f;
-  box->CreateFixture(&fixture);
-
-  // The core square, exactly as Box2D stores it (the skin m_radius is not part of it).
-  const auto* core = static_cast<const b2PolygonShape*>(box->GetFixtureList()->GetShape());
-  std::vector<Vertex> verts;
-  for (int i = 0; i < core->m_count; ++i) {
-    verts.push_back({core->m_vertices[i].x, core->m_vertices[i].y});
+  FirstContact c;
+  try {
+    c = measure_first_contact({square}, drop.height, drop.angle, speed, drop.spin, dt);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string("fig3: ") + e.what());
   }
-
-  const float h = static_cast<float>(dt);
   Fig3Trial trial;
-  std::vector<State> starts;  // Box2D's state at the start of each step
-  int report = -1;
-  for (int step = 0; step < kMaxSteps; ++step) {
-    const State s0 = read_state(box);
-    starts.push_back(s0);
-    world.Step(h, 8, 3);
-    if (touching_ground(box)) {
-      report = step;
-      break;
-    }
-    // No contact: the step must have been pure free flight.
-    const State s1 = read_state(box);
-    const double hd = h;
-    const double err = std::max({std::fabs(s1.cx - (s0.cx + s0.vx * hd)), std::fabs(s1.cy - (s0.cy + s0.vy * hd)),
-                                 std::fabs(wrap_angle(s1.angle - (s0.angle + s0.w * hd))),
-                                 std::fabs(s1.vx - s0.vx), std::fabs(s1.vy - s0.vy), std::fabs(s1.w - s0.w)});
-    trial.free_flight_error = std::max(trial.free_flight_error, err);
-    if (err > 1e-4) {
-      throw std::runtime_error("fig3: Box2D did not move the square in free flight (deviation " +
-                               std::to_string(err) + " in one step)");
-    }
-  }
-  if (report < 0) {
-    throw std::runtime_error("fig3: Box2D never reported contact with the line");
-  }
-  trial.steps = report + 1;
-  trial.naive_height = box->GetWorldCenter().y;
-  trial.report_gap = core_gap(starts[static_cast<std::size_t>(report)], verts, 0.0);
-
-  // Refine from the start of the step before the report, under free flight, until the core
-  // touches (the search may run past the end of the reporting step if Box2D reported early).
-  const std::size_t from_index = report > 0 ? static_cast<std::size_t>(report - 1) : 0;
-  const State& from = starts[from_index];
-  const std::optional<double> t_star = first_contact_time(from, verts, from.cy / speed + 1.0);
-  if (!t_star) {
-    throw std::runtime_error("fig3: no core contact found after Box2D's report");
-  }
-  trial.height = from.cy + from.vy * *t_star;
-
-  // Cross-check against the exact free flight from the initial state (Box2D's float32 initial
-  // state, moved in double precision). Both describe the same motion up to Box2D's float32
-  // rounding (a few 1e-7 m per step), so they find the same contact -- except that a corner
-  // grazing the line by less than that noise may touch in one and not in the other. The first
-  // contact is the earlier of the two.
-  const State& initial = starts.front();
-  const std::optional<double> t_initial = first_contact_time(initial, verts, initial.cy / speed + 1.0);
-  if (!t_initial) {
-    throw std::runtime_error("fig3: no core contact in the free flight from the initial state");
-  }
-  const double height_initial = initial.cy + initial.vy * *t_initial;
-  const double window_start = static_cast<double>(from_index) * static_cast<double>(h);
-  const double t_refined = window_start + *t_star;
-  const double tolerance = 1e-5 / speed;  // the time to travel 10 micrometres
-  double t_first = t_refined;
-  if (*t_initial < window_start - tolerance) {
-    // A fast corner dipped through the line and out again between steps, unseen by Box2D.
-    trial.missed = true;
-    trial.height = height_initial;
-    t_first = *t_initial;
-  } else if (std::fabs(*t_initial - t_refined) > tolerance) {
-    trial.grazing = true;
-    if (*t_initial < t_refined) {
-      trial.height = height_initial;
-      t_first = *t_initial;
-    }
-  } else {
-    trial.float_drift = std::fabs(trial.height - height_initial);
-  }
-  trial.late = report > 0 && !trial.missed && t_first < static_cast<double>(report) * static_cast<double>(h) - tolerance;
+  trial.height = c.height;
+  trial.report_gap = c.report_gap;
+  trial.naive_height = c.naive_height;
+  trial.float_drift = c.float_drift;
+  trial.free_flight_error = c.free_flight_error;
+  trial.steps = c.steps;
+  trial.late = c.late;
+  trial.missed = c.missed;
+  trial.grazing = c.grazing;
   return trial;
 }
 

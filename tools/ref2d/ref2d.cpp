@@ -2,6 +2,7 @@
 
 #include "common/atomic_file.hpp"
 #include "ref2d/fig3.hpp"
+#include "ref2d/gather2d.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -65,6 +66,8 @@ void register_ref2d_commands(CLI::App& app)
   fig3->add_option("--threads", cmd->options.threads, "Worker threads (0 = all hardware threads)")
       ->capture_default_str();
   fig3->callback([cmd]() { run_fig3_command(*cmd); });
+
+  register_gather2d_commands(app);  // gather2d and compare2d (gather2d.hpp, compare2d.hpp)
 }
 
 }  // namespace statsim::tools

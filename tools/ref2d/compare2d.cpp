@@ -1,0 +1,466 @@
+// `statsim compare2d`: see compare2d.hpp.
+#include "ref2d/compare2d.hpp"
+
+#include "common/atomic_file.hpp"
+#include "ref2d/box2d_util.hpp"
+
+#include "statsim/world2.hpp"
+
+#if __has_include("tables/square2d.hpp")
+#include "tables/square2d.hpp"
+#define STATSIM_HAVE_SQUARE2D 1
+#endif
+#if __has_include("tables/lshape2d.hpp")
+#include "tables/lshape2d.hpp"
+#define STATSIM_HAVE_LSHAPE2D 1
+#endif
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace statsim::tools {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxBodies = 2048;
+using StatWorld = statsim::World2<kMaxBodies>;
+
+std::optional<statsim::SignatureView<2>> signature_for(const std::string& shape)
+{
+#ifdef STATSIM_HAVE_SQUARE2D
+  if (shape == "square") {
+    return statsim::tables::square2d.view();
+  }
+#endif
+#ifdef STATSIM_HAVE_LSHAPE2D
+  if (shape == "lshape") {
+    return statsim::tables::lshape2d.view();
+  }
+#endif
+  (void)shape;
+  return std::nullopt;
+}
+
+Shape2 shape_for(const std::string& shape)
+{
+  if (shape == "square") {
+    return square_shape();
+  }
+  if (shape == "lshape") {
+    return lshape_shape();
+  }
+  throw std::invalid_argument("unknown shape '" + shape + "' (square or lshape)");
+}
+
+std::string fmt(const char* format, double x)
+{
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, x);
+  return buf;
+}
+
+double median(std::vector<double> v)
+{
+  if (v.empty()) {
+    return 0.0;
+  }
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+// Fills the statistics of a method from its final states.
+void analyse(MethodResult& m, const Shape2& shape, const statsim::SignatureView<2>& sig, int falling_steps,
+             int active_steps)
+{
+  const std::size_t n = m.final.size();
+  m.median_ms = median(m.step_ms);
+  m.mean_ms = 0.0;
+  for (double t : m.step_ms) {
+    m.mean_ms += t / static_cast<double>(m.step_ms.size());
+  }
+  m.falling_median_ms = median(std::vector<double>(m.step_ms.begin(), m.step_ms.begin() + falling_steps));
+  m.active_mean_ms = 0.0;
+  for (int i = 0; i < active_steps; ++i) {
+    m.active_mean_ms += m.step_ms[static_cast<std::size_t>(i)] / active_steps;
+  }
+  m.histogram.assign(sig.rest.count + 1, 0.0);
+  m.pile_height = -std::numeric_limits<double>::infinity();
+  m.lowest = std::numeric_limits<double>::infinity();
+  m.mean_x = 0.0;
+  m.max_speed = 0.0;
+  m.kinetic_energy = 0.0;
+  for (const Body2State& b : m.final) {
+    const double c = std::cos(b.angle), s = std::sin(b.angle);
+    const double ux = s, uy = c;  // body-frame up vector R^T (0, 1)
+    std::size_t best = sig.rest.count;
+    double best_angle = 15.0;
+    for (std::uint32_t k = 0; k < sig.rest.count; ++k) {
+      const double nx = static_cast<double>(sig.rest.normals[2 * k]), ny = static_cast<double>(sig.rest.normals[2 * k + 1]);
+      const double a = std::atan2(std::fabs(ux * ny - uy * nx), ux * nx + uy * ny) * 180.0 / kPi;
+      if (a <= best_angle) {
+        best_angle = a;
+        best = k;
+      }
+    }
+    m.histogram[best] += 1.0 / static_cast<double>(n);
+    for (const Point2& p : shape.outline) {
+      const double y = b.y + s * p.x + c * p.y;
+      m.pile_height = std::max(m.pile_height, y);
+      m.lowest = std::min(m.lowest, y);
+    }
+    m.mean_x += b.x / static_cast<double>(n);
+    const double speed = std::hypot(b.vx, b.vy);
+    m.max_speed = std::max(m.max_speed, speed);
+    m.kinetic_energy += 0.5 * shape.area * (speed * speed + shape.polar_inertia / shape.area * b.w * b.w);
+  }
+  m.mad_x = 0.0;
+  for (const Body2State& b : m.final) {
+    m.mad_x += std::fabs(b.x - m.mean_x) / static_cast<double>(n);
+  }
+}
+
+MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, const statsim::SignatureView<2>& sig,
+                            const std::vector<Body2State>& init)
+{
+  MethodResult m;
+  m.method = "box2d";
+  b2World world(b2Vec2(0.0f, -9.81f));
+  world.SetAllowSleeping(true);
+  Surface surface;
+  surface.friction = sig.material.friction;
+  surface.restitution = sig.material.restitution;
+  surface.restitution_threshold = sig.restitution_threshold;
+  surface.density = 1.0f;
+  create_ground(world, surface, 1000.0f);
+  const std::vector<b2PolygonShape> pieces = box2d_pieces(shape);
+  std::vector<b2Body*> bodies;
+  for (const Body2State& s : init) {
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position.Set(static_cast<float>(s.x), static_cast<float>(s.y));
+    def.angle = static_cast<float>(s.angle);
+    def.linearVelocity.Set(static_cast<float>(s.vx), static_cast<float>(s.vy));
+    def.angularVelocity = static_cast<float>(s.w);
+    bodies.push_back(create_body(world, def, pieces, surface));
+  }
+  const float h = static_cast<float>(o.dt);
+  for (int step = 0; step < o.steps; ++step) {
+    const auto t0 = std::chrono::steady_clock::now();
+    world.Step(h, 8, 3);
+    const auto t1 = std::chrono::steady_clock::now();
+    m.step_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    int awake = 0;
+    for (b2Body* b : bodies) {
+      awake += b->IsAwake() ? 1 : 0;
+    }
+    if (m.first_sleep_step < 0 && awake < static_cast<int>(bodies.size())) {
+      m.first_sleep_step = step;
+    }
+    if (awake == 0 && m.all_asleep_step < 0) {
+      m.all_asleep_step = step;
+    } else if (awake > 0) {
+      m.all_asleep_step = -1;
+    }
+  }
+  for (b2Body* b : bodies) {
+    const b2Vec2 p = b->GetPosition();
+    const b2Vec2 v = b->GetLinearVelocity();
+    m.final.push_back({p.x, p.y, b->GetAngle(), v.x, v.y, b->GetAngularVelocity()});
+    m.asleep += b->IsAwake() ? 0 : 1;
+  }
+  return m;
+}
+
+MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::SignatureView<2>& sig,
+                              const std::vector<Body2State>& init)
+{
+  MethodResult m;
+  m.method = "statsim";
+  statsim::WorldDef2 def;
+  def.restitution_threshold = sig.restitution_threshold;  // as Box2D's (1 m/s)
+  auto world = std::make_unique<StatWorld>(def);
+  if (world->construction_status() != statsim::Status::ok) {
+    throw std::runtime_error("statsim world rejected its parameters");
+  }
+  const auto shape = world->add_shape(sig);
+  if (shape.status != statsim::Status::ok) {
+    throw std::runtime_error("statsim rejected the signature " + std::string(sig.name));
+  }
+  world->add_plane(statsim::Vector2(0.0f, 1.0f), 0.0f);
+  for (const Body2State& s : init) {
+    statsim::BodyDef2 b;
+    b.position = statsim::Vector2(static_cast<float>(s.x), static_cast<float>(s.y));
+    b.orientation = statsim::Rot2::from_angle(static_cast<float>(s.angle));
+    b.linear_velocity = statsim::Vector2(static_cast<float>(s.vx), static_cast<float>(s.vy));
+    b.angular_velocity = static_cast<float>(s.w);
+    b.shape = shape.id;
+    b.mass = sig.mass;
+    if (world->add_body(b).status != statsim::Status::ok) {
+      throw std::runtime_error("statsim rejected a body");
+    }
+  }
+  const float h = static_cast<float>(o.dt);
+  for (int step = 0; step < o.steps; ++step) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const statsim::StepResult r = world->step(h);
+    const auto t1 = std::chrono::steady_clock::now();
+    if (r.status != statsim::Status::ok) {
+      throw std::runtime_error("statsim step failed");
+    }
+    m.step_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    const std::uint32_t asleep = world->count(statsim::MotionState::asleep);
+    if (m.first_sleep_step < 0 && asleep > 0) {
+      m.first_sleep_step = step;
+    }
+    if (asleep == world->body_count() && m.all_asleep_step < 0) {
+      m.all_asleep_step = step;
+    } else if (asleep < world->body_count()) {
+      m.all_asleep_step = -1;
+    }
+  }
+  for (std::uint32_t i = 0; i < world->body_count(); ++i) {
+    const statsim::Body2& b = world->body(i);
+    m.final.push_back({b.position.x(), b.position.y(), b.orientation.angle(), b.linear_velocity.x(),
+                       b.linear_velocity.y(), b.angular_velocity});
+    m.asleep += b.state == statsim::MotionState::asleep ? 1 : 0;
+  }
+  return m;
+}
+
+// Runs a simulation `repeat` times from the same initial states: every run must end in the same
+// final states (both engines are deterministic), and each step's time is the least over the runs,
+// which removes most of the noise of a shared machine.
+template <class Run>
+MethodResult repeated(int repeat, Run run)
+{
+  MethodResult best = run();
+  for (int k = 1; k < repeat; ++k) {
+    const MethodResult m = run();
+    for (std::size_t i = 0; i < best.final.size(); ++i) {
+      const Body2State& a = best.final[i];
+      const Body2State& b = m.final[i];
+      if (a.x != b.x || a.y != b.y || a.angle != b.angle) {
+        throw std::runtime_error(best.method + " did not repeat itself from the same initial states");
+      }
+    }
+    for (std::size_t i = 0; i < best.step_ms.size(); ++i) {
+      best.step_ms[i] = std::min(best.step_ms[i], m.step_ms[i]);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+bool compare2d_has_table(const std::string& shape)
+{
+  return signature_for(shape).has_value();
+}
+
+std::vector<Body2State> compare2d_initial_states(const Compare2dOptions& o, double bounding_radius)
+{
+  // Random positions, not a grid: bodies dropped in aligned columns land exactly on top of each
+  // other, which says more about the columns than about either simulation. The region is as wide
+  // as a square grid of the bodies at 2R + 0.2 m spacing and twice as tall; each body takes the
+  // first of up to 1000 random spots clear of the others' bounding circles by 0.05 m (the region
+  // grows by a row when that fails).
+  const int columns = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(o.n)))));
+  const double spacing = 2.0 * bounding_radius + 0.2;
+  const double width = columns * spacing;
+  double height = 2.0 * std::ceil(static_cast<double>(o.n) / columns) * spacing;
+  const double clear = 2.0 * bounding_radius + 0.05;
+  std::vector<Body2State> out;
+  for (int i = 0; i < o.n; ++i) {
+    std::mt19937_64 rng = trial_rng(o.seed, 4, static_cast<std::uint64_t>(o.n), static_cast<std::uint64_t>(i));
+    Body2State s;
+    for (int attempt = 0;; ++attempt) {
+      if (attempt > 0 && attempt % 1000 == 0) {
+        height += spacing;
+      }
+      s.x = (uniform01(rng) - 0.5) * (width - spacing);
+      s.y = bounding_radius + 0.5 + uniform01(rng) * height;
+      bool free = true;
+      for (const Body2State& t : out) {
+        if (std::hypot(t.x - s.x, t.y - s.y) < clear) {
+          free = false;
+          break;
+        }
+      }
+      if (free) {
+        break;
+      }
+    }
+    s.angle = 2.0 * kPi * uniform01(rng);
+    s.vx = 2.0 * uniform01(rng) - 1.0;
+    s.vy = -uniform01(rng);
+    s.w = 4.0 * uniform01(rng) - 2.0;
+    out.push_back(s);
+  }
+  return out;
+}
+
+Compare2dResult run_compare2d(const Compare2dOptions& o)
+{
+  if (o.n < 1 || o.n > kMaxBodies) {
+    throw std::invalid_argument("--n must be in 1.." + std::to_string(kMaxBodies));
+  }
+  if (o.steps < 1) {
+    throw std::invalid_argument("--steps must be at least 1");
+  }
+  if (o.repeat < 1) {
+    throw std::invalid_argument("--repeat must be at least 1");
+  }
+  if (!(o.dt > 0.0 && o.dt <= 0.1)) {
+    throw std::invalid_argument("--dt must be in (0, 0.1] s");
+  }
+  const Shape2 shape = shape_for(o.shape);
+  const std::optional<statsim::SignatureView<2>> sig = signature_for(o.shape);
+  if (!sig) {
+    throw std::invalid_argument("no table for '" + o.shape + "' was compiled in: generate tables/" + o.shape +
+                                "2d.hpp with `statsim gather2d` and rebuild");
+  }
+  Compare2dResult r;
+  r.options = o;
+  r.table = sig->name;
+  for (std::uint32_t k = 0; k < sig->rest.count; ++k) {
+    r.categories.push_back("pose" + std::to_string(k) + " (" + fmt("%+.2f", static_cast<double>(sig->rest.normals[2 * k])) +
+                           "," + fmt("%+.2f", static_cast<double>(sig->rest.normals[2 * k + 1])) + ")");
+  }
+  r.categories.push_back("other");
+  const std::vector<Body2State> init = compare2d_initial_states(o, shape.bounding_radius);
+  r.box2d = repeated(o.repeat, [&] { return run_box2d_once(o, shape, *sig, init); });
+  r.statsim = repeated(o.repeat, [&] { return run_statsim_once(o, *sig, init); });
+  const int b = r.box2d.first_sleep_step < 0 ? o.steps : r.box2d.first_sleep_step;
+  const int s = r.statsim.first_sleep_step < 0 ? o.steps : r.statsim.first_sleep_step;
+  r.falling_steps = std::max(1, std::min(b, s));
+  const int ba = r.box2d.all_asleep_step < 0 ? o.steps : r.box2d.all_asleep_step + 1;
+  const int sa = r.statsim.all_asleep_step < 0 ? o.steps : r.statsim.all_asleep_step + 1;
+  r.active_steps = std::max(ba, sa);
+  analyse(r.box2d, shape, *sig, r.falling_steps, r.active_steps);
+  analyse(r.statsim, shape, *sig, r.falling_steps, r.active_steps);
+  // Distances of statsim's result from Box2D's.
+  double tvd = 0.0;
+  for (std::size_t k = 0; k < r.box2d.histogram.size(); ++k) {
+    tvd += 0.5 * std::fabs(r.statsim.histogram[k] - r.box2d.histogram[k]);
+  }
+  r.statsim.rest_tvd = tvd;
+  std::vector<double> xb, xs;
+  for (std::size_t i = 0; i < init.size(); ++i) {
+    xb.push_back(r.box2d.final[i].x);
+    xs.push_back(r.statsim.final[i].x);
+  }
+  std::sort(xb.begin(), xb.end());
+  std::sort(xs.begin(), xs.end());
+  double w1 = 0.0;
+  for (std::size_t i = 0; i < xb.size(); ++i) {
+    w1 += std::fabs(xb[i] - xs[i]) / static_cast<double>(xb.size());
+  }
+  r.statsim.spread_w1 = r.box2d.mad_x > 0.0 ? w1 / r.box2d.mad_x : w1;
+  return r;
+}
+
+std::string compare2d_table(const Compare2dResult& r)
+{
+  const Compare2dOptions& o = r.options;
+  const MethodResult& b = r.box2d;
+  const MethodResult& s = r.statsim;
+  std::string t;
+  t += "compare2d: " + std::to_string(o.n) + " x " + o.shape + " (table " + r.table + "), " + std::to_string(o.steps) +
+       " steps of " + fmt("%.5g", o.dt) + " s, seed " + std::to_string(o.seed) + "; step times: least of " +
+       std::to_string(o.repeat) + " identical runs\n";
+  t += "                                    box2d      statsim\n";
+  const auto row = [&](const std::string& label, const std::string& x, const std::string& y) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "  %-30s %11s  %11s\n", label.c_str(), x.c_str(), y.c_str());
+    t += buf;
+  };
+  row("step time, median (ms)", fmt("%.4f", b.median_ms), fmt("%.4f", s.median_ms));
+  row("step time, mean (ms)", fmt("%.4f", b.mean_ms), fmt("%.4f", s.mean_ms));
+  row("falling: first " + std::to_string(r.falling_steps) + " steps, median", fmt("%.4f", b.falling_median_ms),
+      fmt("%.4f", s.falling_median_ms));
+  row("until all asleep: " + std::to_string(r.active_steps) + " steps, mean", fmt("%.4f", b.active_mean_ms),
+      fmt("%.4f", s.active_mean_ms));
+  row("first step with a sleeper", std::to_string(b.first_sleep_step), std::to_string(s.first_sleep_step));
+  row("all asleep from step", std::to_string(b.all_asleep_step), std::to_string(s.all_asleep_step));
+  row("asleep at the end", std::to_string(b.asleep), std::to_string(s.asleep));
+  for (std::size_t k = 0; k < r.categories.size(); ++k) {
+    row("rest " + r.categories[k], fmt("%.3f", b.histogram[k]), fmt("%.3f", s.histogram[k]));
+  }
+  row("rest-orientation TVD", "0", fmt("%.3f", s.rest_tvd));
+  row("mean x (m)", fmt("%.3f", b.mean_x), fmt("%.3f", s.mean_x));
+  row("mean |x - mean| (m)", fmt("%.3f", b.mad_x), fmt("%.3f", s.mad_x));
+  row("spread W1 / box2d spread", "0", fmt("%.3f", s.spread_w1));
+  row("pile height (m)", fmt("%.3f", b.pile_height), fmt("%.3f", s.pile_height));
+  row("lowest point (m)", fmt("%.4f", b.lowest), fmt("%.4f", s.lowest));
+  row("largest final speed (m/s)", fmt("%.4f", b.max_speed), fmt("%.4f", s.max_speed));
+  row("final kinetic energy (J)", fmt("%.4g", b.kinetic_energy), fmt("%.4g", s.kinetic_energy));
+  t += "  speed-up per step: " + fmt("%.1f", b.median_ms / std::max(s.median_ms, 1e-12)) + "x (median), " +
+       fmt("%.1f", b.mean_ms / std::max(s.mean_ms, 1e-12)) + "x (mean), " +
+       fmt("%.1f", b.falling_median_ms / std::max(s.falling_median_ms, 1e-12)) + "x while falling, " +
+       fmt("%.1f", b.active_mean_ms / std::max(s.active_mean_ms, 1e-12)) + "x until all asleep\n";
+  return t;
+}
+
+std::string compare2d_csv(const Compare2dResult& r)
+{
+  std::string s = "method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep\n";
+  for (const MethodResult* m : {&r.box2d, &r.statsim}) {
+    s += m->method + "," + std::to_string(r.options.n) + "," + std::to_string(r.options.steps) + "," +
+         fmt("%.6f", m->median_ms) + "," + fmt("%.6f", m->mean_ms) + "," + fmt("%.6f", m->falling_median_ms) + "," + fmt("%.6f", m->active_mean_ms) + "," +
+         fmt("%.6f", m->rest_tvd) + "," + fmt("%.6f", m->spread_w1) + "," + fmt("%.6f", m->pile_height) + "," +
+         std::to_string(m->asleep) + "\n";
+  }
+  return s;
+}
+
+void register_compare2d_command(CLI::App& app)
+{
+  struct Command {
+    Compare2dOptions options;
+    std::string csv;
+  };
+  auto cmd = std::make_shared<Command>();
+  CLI::App* c = app.add_subcommand(
+      "compare2d",
+      "Drop N bodies in Box2D (full polygons) and in statsim (statistical bodies from tables/NAME2d.hpp) from the "
+      "same initial states; compare time per step, rest orientations, spread and pile height");
+  c->add_option("--shape", cmd->options.shape, "square or lshape")
+      ->check(CLI::IsMember({"square", "lshape"}))
+      ->capture_default_str();
+  c->add_option("--n", cmd->options.n, "Number of bodies")->check(CLI::Range(1, kMaxBodies))->capture_default_str();
+  c->add_option("--steps", cmd->options.steps, "Steps of 1/60 s for each simulation")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
+  c->add_option("--seed", cmd->options.seed, "Seed of the initial states")->capture_default_str();
+  c->add_option("--repeat", cmd->options.repeat, "Run each simulation this many times; a step's time is the least")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  c->add_option("--csv", cmd->csv, "Also write one CSV row per method to this file");
+  c->callback([cmd]() {
+    try {
+      const Compare2dResult r = run_compare2d(cmd->options);
+      std::fputs(compare2d_table(r).c_str(), stdout);
+      if (!cmd->csv.empty()) {
+        write_file_atomic(cmd->csv, compare2d_csv(r));
+        std::printf("wrote %s\n", cmd->csv.c_str());
+      }
+      std::fflush(stdout);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "statsim compare2d: error: %s\n", e.what());
+      throw CLI::RuntimeError(1);
+    }
+  });
+}
+
+}  // namespace statsim::tools

@@ -1,0 +1,84 @@
+// `statsim compare2d`: the same drop of N bodies in Box2D (full polygons) and in statsim's World2
+// (statistical bodies from the committed tables/NAME2d.hpp), side by side: time per step and how
+// far the statistical result is from Box2D's.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace statsim::tools {
+
+struct Compare2dOptions {
+  std::string shape = "square";  ///< "square" or "lshape" (a committed table must exist)
+  int n = 100;                   ///< bodies, 1..2048
+  int steps = 900;               ///< steps of dt for both simulations
+  double dt = 1.0 / 60.0;
+  std::uint64_t seed = 1;
+  int repeat = 3;                ///< runs per simulation; each step's time is the least of them
+};
+
+/// Initial state of one body (both simulations start from these).
+struct Body2State {
+  double x = 0.0, y = 0.0, angle = 0.0, vx = 0.0, vy = 0.0, w = 0.0;
+};
+
+/// One simulation's outcome.
+struct MethodResult {
+  std::string method;                 ///< "box2d" or "statsim"
+  std::vector<double> step_ms;        ///< wall-clock time of every step, ms
+  double median_ms = 0.0;             ///< median over all steps
+  double mean_ms = 0.0;
+  double falling_median_ms = 0.0;     ///< median over the steps before anything sleeps (in either)
+  double active_mean_ms = 0.0;        ///< mean over the steps until both are all asleep (or all steps)
+  int first_sleep_step = -1;          ///< first step after which a body of this method slept (-1: never)
+  int all_asleep_step = -1;           ///< step from which every body stayed asleep (-1: not by the end)
+  int asleep = 0;                     ///< bodies asleep at the end
+  std::vector<Body2State> final;      ///< final states
+  std::vector<double> histogram;      ///< fractions per rest pose of the signature, then "other"
+  double pile_height = 0.0;           ///< highest point of any body (its polygon at its pose), m
+  double mean_x = 0.0;
+  double mad_x = 0.0;                 ///< mean absolute deviation of x, m
+  double rest_tvd = 0.0;              ///< total variation distance of the histograms to Box2D's
+  double spread_w1 = 0.0;             ///< W1 of the x distributions / Box2D's mad_x
+  double lowest = 0.0;                ///< lowest point of any body, m (< 0: sunk into the ground)
+  double max_speed = 0.0;             ///< largest final |v|, m/s
+  double kinetic_energy = 0.0;        ///< final total kinetic energy, J
+};
+
+struct Compare2dResult {
+  Compare2dOptions options;
+  std::string table;                  ///< name of the signature used
+  std::vector<std::string> categories;  ///< rest-pose labels, then "other"
+  int falling_steps = 0;              ///< steps before anything slept in either simulation
+  int active_steps = 0;               ///< steps until both simulations were all asleep (or all steps)
+  MethodResult box2d;
+  MethodResult statsim;
+};
+
+/// Initial states: random positions clear of each other in a region above the ground (as wide as
+/// a square grid of the bodies, twice as tall), random orientations and small random velocities;
+/// deterministic in (seed, n, shape).
+std::vector<Body2State> compare2d_initial_states(const Compare2dOptions& options, double bounding_radius);
+
+/// True when a committed table for `shape` was compiled into the tools.
+bool compare2d_has_table(const std::string& shape);
+
+/// Runs both simulations. Throws std::invalid_argument for bad options or a missing table.
+Compare2dResult run_compare2d(const Compare2dOptions& options);
+
+/// The side-by-side table for humans.
+std::string compare2d_table(const Compare2dResult& result);
+
+/// CSV: header `method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep`,
+/// one row per method (Box2D's distances are 0). step_ms is the median over all steps.
+std::string compare2d_csv(const Compare2dResult& result);
+
+/// Adds `compare2d` to `app`.
+void register_compare2d_command(CLI::App& app);
+
+}  // namespace statsim::tools

@@ -1,0 +1,952 @@
+// `statsim gather2d`: see gather2d.hpp.
+#include "ref2d/gather2d.hpp"
+
+#include "common/atomic_file.hpp"
+#include "common/parallel.hpp"
+#include "common/progress.hpp"
+#include "ref2d/box2d_util.hpp"
+#include "ref2d/compare2d.hpp"
+
+#include "statsim/response.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace statsim::tools {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGravity = 9.81;
+// Experiments: the first word of each trial's seed.
+constexpr std::uint64_t kHeightTable = 1;
+constexpr std::uint64_t kResponseTable = 2;
+constexpr std::uint64_t kRestPoses = 3;
+// Box2D's skins: contact is reported (and resolved) once the cores are within 2 * 0.01 m.
+constexpr double kSkin = 2.0 * static_cast<double>(b2_polygonRadius);
+
+std::string fmt(const char* format, double x)
+{
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, x == 0.0 ? 0.0 : x);
+  return buf;
+}
+
+std::string g6(double x)
+{
+  return fmt("%.6g", x);
+}
+
+// A float as an exact hex-float literal: 0x1.8p-1f.
+std::string hexf(double value)
+{
+  const float f = static_cast<float>(value) + 0.0f;  // no negative zero
+  if (!std::isfinite(f)) {
+    throw std::runtime_error("gather2d: non-finite value in a table");
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%af", static_cast<double>(f));
+  return buf;
+}
+
+std::string hex_array(const std::vector<double>& values, const std::string& indent, std::size_t per_line = 6)
+{
+  if (values.empty()) {
+    return "{}";
+  }
+  std::string s = "{{";
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i % per_line == 0) {
+      s += "\n" + indent + "    ";
+    } else {
+      s += " ";
+    }
+    s += hexf(values[i]);
+    if (i + 1 < values.size()) {
+      s += ",";
+    }
+  }
+  s += "\n" + indent + "}}";
+  return s;
+}
+
+bool is_identifier(const std::string& s)
+{
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) {
+    return false;
+  }
+  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+}
+
+double angle_between(Point2 a, Point2 b)
+{
+  return std::atan2(std::fabs(a.x * b.y - a.y * b.x), a.x * b.x + a.y * b.y) * 180.0 / kPi;
+}
+
+Point2 normalized(Point2 p)
+{
+  const double n = std::hypot(p.x, p.y);
+  return {p.x / n, p.y / n};
+}
+
+// Mean and sample standard deviation, two-pass.
+void mean_std(const std::vector<double>& xs, double& mean, double& std)
+{
+  mean = 0.0;
+  for (double x : xs) {
+    mean += x;
+  }
+  mean /= static_cast<double>(xs.size());
+  double ss = 0.0;
+  for (double x : xs) {
+    ss += (x - mean) * (x - mean);
+  }
+  std = xs.size() > 1 ? std::sqrt(ss / static_cast<double>(xs.size() - 1)) : 0.0;
+}
+
+// ---- the experiments ---------------------------------------------------------------------------
+
+struct Context {
+  Shape2 shape;
+  std::vector<b2PolygonShape> pieces;
+  std::vector<Point2> verts;  // core vertices as Box2D stores them, about the centre of mass
+  double length = 0.0;        // L = bounding radius
+  Surface surface;
+  statsim::Material material;
+  float threshold = 1.0f;
+};
+
+Context make_context(const Gather2dOptions& o)
+{
+  Context c;
+  c.shape = gather2d_shape(o);
+  c.pieces = box2d_pieces(c.shape);
+  c.length = c.shape.bounding_radius;
+  c.surface.friction = static_cast<float>(o.friction);
+  c.surface.restitution = static_cast<float>(o.restitution);
+  c.surface.restitution_threshold = b2FixtureDef().restitutionThreshold;
+  c.surface.density = 1.0f;
+  c.threshold = c.surface.restitution_threshold;
+  c.material.restitution = static_cast<statsim::Scalar>(o.restitution);
+  c.material.friction = static_cast<statsim::Scalar>(o.friction);
+  // Verts exactly as Box2D stores them, relative to its centre of mass.
+  b2World world(b2Vec2(0.0f, 0.0f));
+  b2BodyDef def;
+  def.type = b2_dynamicBody;
+  c.verts = core_vertices(create_body(world, def, c.pieces, c.surface));
+  return c;
+}
+
+// Box2D limits a body's rotation to b2_maxRotation (pi/2) per step: keep below 0.4 rad.
+double step_for_spin(double dt, double max_spin)
+{
+  return max_spin > 0.0 ? std::min(dt, 0.4 / max_spin) : dt;
+}
+
+struct ResponseTrial {
+  double out[3] = {0.0, 0.0, 0.0};
+  int steps = 0;
+  char time_limited = 0;
+};
+
+// One response trial (paper 3.2.2) in the canonical frame: ground y = 0 with normal +y, V- =
+// |V-| (sin theta, -cos theta) (non-negative x), spin w = s |V-| / L (counter-clockwise positive,
+// as in the runtime's 2D frame). No gravity. Box2D steps until the collision is over:
+//  - separated: no touching contact, moving up, and the exact free flight (box2d_util's
+//    first_contact_time) does not bring the core within the skin of the ground again before the
+//    centre is clear of it (looked at up to 1 s ahead); or
+//  - sliding: velocities unchanged for 16 steps and not approaching (slow grazing contacts end
+//    like this without gravity: no normal force, so no friction);
+//  - else the time limit after the first contact (counted; a body rocking on a corner without
+//    gravity can take long), whose final velocities are used.
+// Output: W+ L / |V-|, (V_rigid+ - V_particle+) / |V-| with V_particle+ from the runtime's
+// statsim::point_particle_velocity<2> on Box2D's float V- (same material and threshold).
+ResponseTrial simulate_response(const Context& ctx, double cos_theta, double spin_ratio, double speed, double dt,
+                                double time_limit, std::mt19937_64& rng)
+{
+  const Shape2& shape = ctx.shape;
+  const double angle = 2.0 * kPi * uniform01(rng);
+  const double phase = uniform01(rng);
+  const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+  const double vn = speed * cos_theta;
+  const double vx = speed * sin_theta;
+  const double w = spin_ratio * speed / ctx.length;
+  // The paper's protocol: random orientation at a fixed height (clear of Box2D's skin and its
+  // fat-AABB margin), plus a random fraction of one step's travel so that contacts fall anywhere
+  // within a step. The first contact is whatever the approaching, turning body touches first.
+  const double height = shape.bounding_radius + 0.03 + phase * vn * dt;
+  const double t_estimate = (height - 0.5 * (shape.bounding_radius + shape.inradius_min)) / vn;
+
+  b2World world(b2Vec2(0.0f, 0.0f));
+  world.SetAllowSleeping(false);
+  create_ground(world, ctx.surface, 100.0f);
+  b2BodyDef def;
+  def.type = b2_dynamicBody;
+  def.position.Set(static_cast<float>(-vx * t_estimate), static_cast<float>(height));
+  def.angle = static_cast<float>(angle);
+  def.linearVelocity.Set(static_cast<float>(vx), static_cast<float>(-vn));
+  def.angularVelocity = static_cast<float>(w);
+  def.allowSleep = false;
+  b2Body* body = create_body(world, def, ctx.pieces, ctx.surface);
+
+  const b2Vec2 v0 = body->GetLinearVelocity();
+  const float h = static_cast<float>(dt);
+  const int free_steps = static_cast<int>(std::ceil((2.0 * t_estimate + 1.0) / dt));
+  const int contact_steps = static_cast<int>(std::ceil(time_limit / dt));
+  const double still = 1e-6 * speed;
+  ResponseTrial trial;
+  int first_contact = -1;
+  int quiet = 0;
+  for (int step = 0;; ++step) {
+    if (first_contact < 0 && step >= free_steps) {
+      throw std::runtime_error("gather2d: Box2D never reported the body touching the ground");
+    }
+    if (first_contact >= 0 && step - first_contact >= contact_steps) {
+      trial.time_limited = 1;
+      break;
+    }
+    const b2Vec2 pv = body->GetLinearVelocity();
+    const float pw = body->GetAngularVelocity();
+    world.Step(h, 8, 3);
+    trial.steps = step + 1;
+    const bool touching = touching_anything(body);
+    if (first_contact < 0) {
+      if (!touching) {
+        continue;
+      }
+      first_contact = step;
+    }
+    const b2Vec2 v = body->GetLinearVelocity();
+    const float wv = body->GetAngularVelocity();
+    const bool changed = std::hypot(static_cast<double>(v.x) - pv.x, static_cast<double>(v.y) - pv.y) > still ||
+                         std::fabs(static_cast<double>(wv) - pw) * ctx.length > still;
+    quiet = changed ? 0 : quiet + 1;
+    if (!touching && v.y > 0.0f) {
+      // Free flight from here: separated for good if the core never comes within the skin of the
+      // ground again, checked exactly until the centre is clear of it (at most 1 s ahead).
+      const FreeState s = read_state(body);
+      const double clear = (shape.bounding_radius + kSkin + 0.01 - s.cy) / s.vy;
+      const double horizon = std::min(1.0, std::max(0.0, clear));
+      if (!first_contact_time(s, ctx.verts, horizon, kSkin + 0.005)) {
+        break;
+      }
+    }
+    // Sliding along the ground with nothing more happening (slow grazing contacts without
+    // gravity end this way: no normal force, so no friction).
+    if (quiet >= 16 && static_cast<double>(v.y) >= -still) {
+      break;
+    }
+  }
+
+  const b2Vec2 v1 = body->GetLinearVelocity();
+  const float w1 = body->GetAngularVelocity();
+  const statsim::Vector2 vminus(v0.x, v0.y);
+  const statsim::Vector2 vp = statsim::point_particle_velocity<2>(vminus, statsim::Vector2(0.0f, 1.0f), ctx.material,
+                                                                 ctx.threshold);
+  const double s = static_cast<double>(vminus.norm());
+  trial.out[0] = static_cast<double>(w1) * ctx.length / s;
+  trial.out[1] = (static_cast<double>(v1.x) - static_cast<double>(vp.x())) / s;
+  trial.out[2] = (static_cast<double>(v1.y) - static_cast<double>(vp.y())) / s;
+  return trial;
+}
+
+struct RestTrial {
+  Point2 up;
+  char settled = 0;
+};
+
+RestTrial simulate_rest(const Context& ctx, const Gather2dOptions& o, std::mt19937_64& rng)
+{
+  const double angle = 2.0 * kPi * uniform01(rng);
+  const double height = ctx.shape.bounding_radius + 0.05 + 1.5 * uniform01(rng);
+  const double vx = 2.0 * uniform01(rng) - 1.0;
+  const double vy = 2.0 * uniform01(rng) - 1.0;
+  const double w = (2.0 * uniform01(rng) - 1.0) * 2.0 * kPi;
+
+  b2World world(b2Vec2(0.0f, static_cast<float>(-kGravity)));
+  world.SetAllowSleeping(true);
+  create_ground(world, ctx.surface, 1000.0f);
+  b2BodyDef def;
+  def.type = b2_dynamicBody;
+  def.position.Set(0.0f, static_cast<float>(height));
+  def.angle = static_cast<float>(angle);
+  def.linearVelocity.Set(static_cast<float>(vx), static_cast<float>(vy));
+  def.angularVelocity = static_cast<float>(w);
+  b2Body* body = create_body(world, def, ctx.pieces, ctx.surface);
+  const int max_steps = static_cast<int>(std::ceil(o.rest_time_limit / o.rest_dt));
+  const float h = static_cast<float>(o.rest_dt);
+  RestTrial t;
+  for (int step = 0; step < max_steps && body->IsAwake(); ++step) {
+    world.Step(h, 8, 3);
+  }
+  t.settled = body->IsAwake() ? 0 : 1;
+  const double a = body->GetAngle();
+  t.up = {std::sin(a), std::cos(a)};  // R^T (0, 1)
+  return t;
+}
+
+void cluster_rest_poses(Gather2dResult& r)
+{
+  const Gather2dOptions& o = r.options;
+  struct Acc {
+    Point2 sum;
+    std::vector<std::size_t> members;
+  };
+  std::vector<Acc> acc;
+  for (std::size_t i = 0; i < r.rest_ups.size(); ++i) {
+    if (!r.rest_settled[i]) {
+      continue;
+    }
+    const Point2 u = r.rest_ups[i];
+    std::size_t best = acc.size();
+    double best_angle = o.cluster_degrees;
+    for (std::size_t k = 0; k < acc.size(); ++k) {
+      const double a = angle_between(u, normalized(acc[k].sum));
+      if (a <= best_angle) {
+        best_angle = a;
+        best = k;
+      }
+    }
+    if (best == acc.size()) {
+      acc.push_back({{0.0, 0.0}, {}});
+    }
+    acc[best].sum.x += u.x;
+    acc[best].sum.y += u.y;
+    acc[best].members.push_back(i);
+  }
+  // Up vectors of the faces of the convex hull: a polygon at rest lies on a hull edge.
+  std::vector<Point2> faces;
+  const std::vector<Point2>& hull = r.shape.hull;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Point2 a = hull[i], b = hull[(i + 1) % hull.size()];
+    faces.push_back(normalized({-(b.y - a.y), b.x - a.x}));  // minus the outward normal
+  }
+  r.clusters.clear();
+  const double total = static_cast<double>(r.rest_ups.size());
+  for (const Acc& a : acc) {
+    RestCluster c;
+    const Point2 mean = normalized(a.sum);
+    c.normal = mean;
+    c.count = static_cast<int>(a.members.size());
+    c.frequency = static_cast<double>(c.count) / total;
+    for (std::size_t m : a.members) {
+      c.spread_degrees = std::max(c.spread_degrees, angle_between(r.rest_ups[m], mean));
+    }
+    // Snap to the nearest hull face within 3 degrees: Box2D leaves a resting body tilted by its
+    // solver tolerances only, and the exact face gives the exact rest height.
+    double best = 3.0;
+    for (const Point2& f : faces) {
+      const double d = angle_between(mean, f);
+      if (d <= best) {
+        best = d;
+        c.normal = f;
+        c.snap_degrees = d;
+      }
+    }
+    c.height = r.shape.support_height(c.normal);
+    c.kept = c.frequency > o.min_frequency;
+    r.clusters.push_back(c);
+  }
+  std::stable_sort(r.clusters.begin(), r.clusters.end(), [](const RestCluster& a, const RestCluster& b) {
+    if (a.kept != b.kept) {
+      return a.kept;
+    }
+    if (a.count != b.count) {
+      return a.count > b.count;
+    }
+    return std::atan2(a.normal.x, a.normal.y) < std::atan2(b.normal.x, b.normal.y);
+  });
+}
+
+void rest_experiment(const Context& ctx, Gather2dResult& r)
+{
+  const Gather2dOptions& o = r.options;
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t n = static_cast<std::size_t>(o.rest_drops);
+  Progress progress("gather2d rest poses", n, o.progress);
+  const std::vector<RestTrial> trials = parallel_map(
+      n,
+      [&](std::size_t i) {
+        std::mt19937_64 rng = trial_rng(o.seed, kRestPoses, 0, i);
+        RestTrial t = simulate_rest(ctx, o, rng);
+        progress.add();
+        return t;
+      },
+      o.threads);
+  progress.finish();
+  r.rest_drops = static_cast<int>(n);
+  r.rest_ups.clear();
+  r.rest_settled.clear();
+  r.rest_time_limited = 0;
+  for (const RestTrial& t : trials) {
+    r.rest_ups.push_back(t.up);
+    r.rest_settled.push_back(t.settled);
+    r.rest_time_limited += t.settled ? 0 : 1;
+  }
+  cluster_rest_poses(r);
+  r.seconds_rest = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void warm_up_box2d(const Context& ctx)
+{
+  // Box2D 2.4.1 fills its contact-function table lazily on first use (b2Contact::Create): do that
+  // on one thread before any worker starts.
+  measure_first_contact(ctx.pieces, ctx.shape.bounding_radius + 0.1, 0.0, 1.0, 0.0, 1.0 / 60.0);
+}
+
+}  // namespace
+
+std::vector<double> default_height_ratios()
+{
+  // Below s ~ 1 the body turns by less than ~0.3 rad while crossing its height band (bounding
+  // radius to inradius), so the heights barely change; beyond, the mean climbs slowly toward L.
+  return {0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 13.0, 17.0, 23.0, 32.0};
+}
+std::vector<double> default_cos_thetas()
+{
+  return {0.15, 0.3, 0.5, 0.7, 0.85, 0.95, 1.0};
+}
+std::vector<double> default_signed_spins()
+{
+  return {-6.0, -3.0, -1.5, -0.5, 0.0, 0.5, 1.5, 3.0, 6.0};
+}
+std::vector<double> default_speeds()
+{
+  return {0.5, 1.5, 3.0, 5.0, 9.0};
+}
+
+Shape2 gather2d_shape(const Gather2dOptions& o)
+{
+  if (o.shape == "square") {
+    return square_shape();
+  }
+  if (o.shape == "lshape") {
+    return lshape_shape();
+  }
+  if (o.shape == "polygon") {
+    const std::vector<Point2> v = parse_polygon(o.polygon);
+    return make_shape(v, "polygon", "polygon " + format_polygon(v) + " (as given; centred on its centroid)");
+  }
+  throw std::invalid_argument("unknown shape '" + o.shape + "' (square, lshape or polygon)");
+}
+
+void validate_gather2d_options(const Gather2dOptions& o)
+{
+  const auto bad = [](const std::string& m) { throw std::invalid_argument(m); };
+  if (!is_identifier(o.name)) {
+    bad("the table name '" + o.name + "' is not a C++ identifier (use --name)");
+  }
+  if (!(o.restitution >= 0.0 && o.restitution <= 1.0)) {
+    bad("--restitution must be in [0, 1]");
+  }
+  if (!(o.friction >= 0.0 && std::isfinite(o.friction))) {
+    bad("--friction must be >= 0");
+  }
+  if (o.height_trials < 2 || o.trials < 2) {
+    bad("need at least 2 trials per table entry (for a standard deviation)");
+  }
+  if (o.rest_drops < 20) {
+    bad("--rest-drops must be at least 20");
+  }
+  const auto increasing = [&](const std::vector<double>& a, const char* what, double lo, double hi) {
+    if (a.empty()) {
+      bad(std::string(what) + ": need at least one value");
+    }
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!std::isfinite(a[i]) || a[i] < lo || a[i] > hi || (i > 0 && !(a[i] > a[i - 1]))) {
+        bad(std::string(what) + ": values must be strictly increasing within [" + g6(lo) + ", " + g6(hi) + "]");
+      }
+    }
+  };
+  increasing(o.height_ratios, "height spin ratios", 0.0, 1e3);
+  increasing(o.cos_thetas, "cos(theta) axis", 0.05, 1.0);
+  increasing(o.signed_spins, "signed spin axis", -1e3, 1e3);
+  increasing(o.speeds, "speed axis", 0.05, 100.0);
+  if (!(o.height_speed > 0.0) || !(o.response_dt > 0.0) || !(o.rest_dt > 0.0) || !(o.response_time_limit > 0.0) ||
+      !(o.rest_time_limit > 0.0)) {
+    bad("speeds, time steps and time limits must be positive");
+  }
+  if (o.speeds.back() * o.response_dt >= 1.0) {
+    bad("the largest speed moves too far per Box2D step (b2_maxTranslation is 2 m)");
+  }
+  (void)gather2d_shape(o);  // a bad polygon throws here
+}
+
+Gather2dResult run_rest_poses(const Gather2dOptions& options)
+{
+  validate_gather2d_options(options);
+  Gather2dResult r;
+  r.options = options;
+  const Context ctx = make_context(options);
+  r.shape = ctx.shape;
+  r.length = ctx.length;
+  r.restitution_threshold = ctx.threshold;
+  warm_up_box2d(ctx);
+  rest_experiment(ctx, r);
+  return r;
+}
+
+Gather2dResult run_gather2d(const Gather2dOptions& options)
+{
+  validate_gather2d_options(options);
+  const Gather2dOptions& o = options;
+  Gather2dResult r;
+  r.options = o;
+  const Context ctx = make_context(o);
+  r.shape = ctx.shape;
+  r.length = ctx.length;
+  r.restitution_threshold = ctx.threshold;
+  warm_up_box2d(ctx);
+
+  // 1. Height table.
+  {
+    const auto start = std::chrono::steady_clock::now();
+    const double max_spin = o.height_ratios.back() * o.height_speed / ctx.length;
+    r.height_dt = step_for_spin(1.0 / 60.0, max_spin);
+    const std::size_t nr = o.height_ratios.size();
+    const std::size_t per = static_cast<std::size_t>(o.height_trials);
+    Progress progress("gather2d heights", nr * per, o.progress);
+    const std::vector<FirstContact> trials = parallel_map(
+        nr * per,
+        [&](std::size_t flat) {
+          const std::size_t i = flat / per, k = flat % per;
+          std::mt19937_64 rng = trial_rng(o.seed, kHeightTable, i, k);
+          const double angle = 2.0 * kPi * uniform01(rng);
+          const double sign = (rng() >> 63) != 0 ? 1.0 : -1.0;
+          const double spin = sign * o.height_ratios[i] * o.height_speed / ctx.length;
+          // Start clear of the skin and the fat-AABB margin, at a random phase of one step.
+          const double height = ctx.shape.bounding_radius + 0.1 + uniform01(rng) * o.height_speed * r.height_dt;
+          FirstContact t = measure_first_contact(ctx.pieces, height, angle, o.height_speed, spin, r.height_dt);
+          progress.add();
+          return t;
+        },
+        o.threads);
+    progress.finish();
+    for (std::size_t i = 0; i < nr; ++i) {
+      HeightRow row;
+      row.ratio = o.height_ratios[i];
+      std::vector<double> hs;
+      for (std::size_t k = 0; k < per; ++k) {
+        const FirstContact& t = trials[i * per + k];
+        hs.push_back(t.height);
+        row.late += t.late ? 1 : 0;
+        row.missed += t.missed ? 1 : 0;
+      }
+      mean_std(hs, row.mean, row.std);
+      row.min = *std::min_element(hs.begin(), hs.end());
+      row.max = *std::max_element(hs.begin(), hs.end());
+      row.trials = static_cast<int>(per);
+      r.heights.push_back(row);
+    }
+    r.seconds_heights = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  // 2. Response tables.
+  {
+    const auto start = std::chrono::steady_clock::now();
+    double max_abs_spin = 0.0;
+    for (double s : o.signed_spins) {
+      max_abs_spin = std::max(max_abs_spin, std::fabs(s));
+    }
+    r.response_dt = step_for_spin(o.response_dt, max_abs_spin * o.speeds.back() / ctx.length);
+    const std::size_t a0 = o.cos_thetas.size(), a1 = o.signed_spins.size(), a2 = o.speeds.size();
+    const std::size_t cells = a0 * a1 * a2;
+    const std::size_t per = static_cast<std::size_t>(o.trials);
+    Progress progress("gather2d responses", cells * per, o.progress);
+    const std::vector<ResponseTrial> trials = parallel_map(
+        cells * per,
+        [&](std::size_t flat) {
+          const std::size_t cell = flat / per, k = flat % per;
+          const std::size_t i = cell / (a1 * a2), j = (cell / a2) % a1, l = cell % a2;
+          std::mt19937_64 rng = trial_rng(o.seed, kResponseTable, cell, k);
+          ResponseTrial t = simulate_response(ctx, o.cos_thetas[i], o.signed_spins[j], o.speeds[l], r.response_dt,
+                                              o.response_time_limit, rng);
+          progress.add();
+          return t;
+        },
+        o.threads);
+    progress.finish();
+    for (std::size_t cell = 0; cell < cells; ++cell) {
+      ResponseCell c;
+      c.cos_theta = o.cos_thetas[cell / (a1 * a2)];
+      c.spin = o.signed_spins[(cell / a2) % a1];
+      c.speed = o.speeds[cell % a2];
+      c.trials = static_cast<int>(per);
+      double steps = 0.0;
+      for (int comp = 0; comp < 3; ++comp) {
+        std::vector<double> xs;
+        for (std::size_t k = 0; k < per; ++k) {
+          xs.push_back(trials[cell * per + k].out[comp]);
+        }
+        mean_std(xs, c.mean[static_cast<std::size_t>(comp)], c.std[static_cast<std::size_t>(comp)]);
+      }
+      for (std::size_t k = 0; k < per; ++k) {
+        c.time_limited += trials[cell * per + k].time_limited;
+        steps += trials[cell * per + k].steps;
+      }
+      c.mean_steps = steps / static_cast<double>(per);
+      r.response_trials += c.trials;
+      r.response_time_limited += c.time_limited;
+      r.cells.push_back(c);
+    }
+    r.seconds_responses = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  // 3. Rest poses.
+  rest_experiment(ctx, r);
+  return r;
+}
+
+std::string shell_quote(const std::string& s)
+{
+  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./,+=:") ==
+                        std::string::npos) {
+    return s;
+  }
+  std::string q = "'";
+  for (char c : s) {
+    q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  }
+  return q + "'";
+}
+
+std::string gather2d_header(const Gather2dResult& r, const std::string& command)
+{
+  const Gather2dOptions& o = r.options;
+  const Shape2& sh = r.shape;
+  std::vector<RestCluster> kept;
+  for (const RestCluster& c : r.clusters) {
+    if (c.kept) {
+      kept.push_back(c);
+    }
+  }
+  int late = 0, missed = 0;
+  for (const HeightRow& h : r.heights) {
+    late += h.late;
+    missed += h.missed;
+  }
+  const auto dt_text = [](double dt) {
+    const double inv = 1.0 / dt;
+    return std::fabs(inv - std::round(inv)) < 1e-9 * inv ? "1/" + fmt("%.0f", inv) : g6(dt);
+  };
+  std::string s;
+  s += "// generated by statsim gather2d \xE2\x80\x94 do not edit\n";
+  s += "// command: " + command + "\n";
+  s += "// (run from the repository root; tools/regenerate-tables.sh regenerates every table and diffs it)\n";
+  s += "// seed " + std::to_string(o.seed) + "; reference: Box2D " + std::to_string(b2_version.major) + "." +
+       std::to_string(b2_version.minor) + " (Debian libbox2d 2.4.1: polygon skin b2_polygonRadius = " +
+       g6(static_cast<double>(b2_polygonRadius)) + " m, b2_linearSlop = " + g6(static_cast<double>(b2_linearSlop)) +
+       " m)\n";
+  s += "// shape: " + sh.description + "\n";
+  s += "//   body frame (centroid at the origin), counter-clockwise: " + format_polygon(sh.outline) + "\n";
+  s += "//   " + std::to_string(sh.pieces.size()) + " convex Box2D fixture(s); area " + g6(sh.area) +
+       " m^2, density 1 kg/m^2, mass " + g6(sh.area) + " kg, polar inertia / mass " + g6(sh.polar_inertia / sh.area) +
+       " m^2; bounding radius = L = " + g6(sh.bounding_radius) + " m\n";
+  s += "// material: restitution " + g6(o.restitution) + ", friction " + g6(o.friction) +
+       " on the body and on the ground (Box2D mixes restitution as max(a, b) and friction as sqrt(a b),\n"
+       "//   so contacts use exactly these); restitution only above " +
+       g6(static_cast<double>(r.restitution_threshold)) +
+       " m/s of approach (b2FixtureDef::restitutionThreshold, recorded as\n"
+       "//   restitution_threshold); rolling_resistance is the runtime's default (Box2D polygons do not roll)\n";
+  s += "// height table (paper 3.2.1): " + std::to_string(r.heights.size()) + " spin ratios s = |w| L / |v| x " +
+       std::to_string(o.height_trials) + " drops, |v| = " + g6(o.height_speed) + " m/s straight down, dt " +
+       dt_text(r.height_dt) + " s, random orientation, spin sign and step phase;\n"
+       "//   centre height at the first contact of the core shape, refined exactly (Box2D skin removed; Box2D noticed " +
+       std::to_string(late) + " contacts\n//   a step late and missed " + std::to_string(missed) +
+       ", covered by the refinement)\n";
+  s += "// response tables (paper 3.2.2): " + std::to_string(o.cos_thetas.size()) + " cos(theta) x " +
+       std::to_string(o.signed_spins.size()) + " signed spin ratios x " + std::to_string(o.speeds.size()) + " speeds = " +
+       std::to_string(r.cells.size()) + " cells x " + std::to_string(o.trials) + " trials = " +
+       std::to_string(r.response_trials) + " trials;\n"
+       "//   no gravity, dt " + dt_text(r.response_dt) +
+       " s, 8 velocity / 3 position iterations, random orientation at a fixed height, until separated;\n"
+       "//   " + std::to_string(r.response_time_limited) + " trials had not separated " + g6(o.response_time_limit) +
+       " s after first contact (time limit; their final velocities are used)\n";
+  s += "// rest poses (paper 3.2.3): " + std::to_string(r.rest_drops) + " drops with gravity " + g6(kGravity) +
+       " m/s^2, dt " + dt_text(o.rest_dt) + " s, until Box2D put the body to sleep; " +
+       std::to_string(r.rest_time_limited) + " were still awake after " + g6(o.rest_time_limit) +
+       " s;\n//   greedy clustering of body-frame up vectors at " + g6(o.cluster_degrees) +
+       " degrees, snapped to hull faces within 3 degrees; kept: frequency > " + g6(o.min_frequency) +
+       "; h_rest on the core shape\n";
+  for (std::size_t i = 0; i < r.clusters.size(); ++i) {
+    const RestCluster& c = r.clusters[i];
+    s += "//   " + std::string(c.kept ? "pose " + std::to_string(i) : "(not kept)") + ": up (" + fmt("%.6f", c.normal.x) +
+         ", " + fmt("%.6f", c.normal.y) + ") h_rest " + fmt("%.6f", c.height) + " m, " + std::to_string(c.count) +
+         " drops, frequency " + fmt("%.4f", c.frequency) + "\n";
+  }
+  s += "#pragma once\n\n#include \"statsim/signature.hpp\"\n\n";
+  s += "static_assert(STATSIM_TABLE_FORMAT_VERSION == 1, \"tables/" + o.name +
+       ".hpp was generated for table format 1: regenerate it with the command above\");\n\n";
+  s += "namespace statsim::tables {\n\n";
+  s += "// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses>\n";
+  s += "inline constexpr Signature<2, " + std::to_string(r.heights.size()) + ", " + std::to_string(o.cos_thetas.size()) +
+       ", " + std::to_string(o.signed_spins.size()) + ", " + std::to_string(o.speeds.size()) + ", 1, " +
+       std::to_string(kept.size()) + "> " + o.name + " = {\n";
+  const std::string in = "    ";
+  statsim::Material defaults;
+  s += in + "\"" + o.name + "\",\n";
+  s += in + hexf(r.length) + ",  // length L (bounding radius), m\n";
+  s += in + hexf(sh.bounding_radius) + ",  // bounding_radius, m\n";
+  s += in + hexf(sh.area) + ",  // mass, kg\n";
+  s += in + "{{" + hexf(sh.polar_inertia / sh.area) + ", " + hexf(0.0) + ", " + hexf(0.0) +
+       "}},  // unit_inertia (polar moment / mass), m^2\n";
+  s += in + "{" + hexf(o.restitution) + ", " + hexf(o.friction) + ", " +
+       hexf(static_cast<double>(defaults.rolling_resistance)) + "},  // material: restitution, friction, rolling\n";
+  s += in + hexf(static_cast<double>(r.restitution_threshold)) + ",  // restitution_threshold, m/s\n";
+  s += in + "ResponseLayout::with_speed,\n";
+  s += in + "3,  // axis_count\n";
+  std::vector<double> hm, hsd;
+  for (const HeightRow& h : r.heights) {
+    hm.push_back(h.mean);
+    hsd.push_back(h.std);
+  }
+  s += in + "// height_axis: spin ratio |w| L / |v|\n" + in + hex_array(o.height_ratios, in) + ",\n";
+  s += in + "// height_mean, m\n" + in + hex_array(hm, in) + ",\n";
+  s += in + "// height_stddev, m\n" + in + hex_array(hsd, in) + ",\n";
+  s += in + "// axis0: cos(theta)\n" + in + hex_array(o.cos_thetas, in) + ",\n";
+  s += in + "// axis1: signed spin ratio\n" + in + hex_array(o.signed_spins, in) + ",\n";
+  s += in + "// axis2: speed |V-|, m/s\n" + in + hex_array(o.speeds, in) + ",\n";
+  s += in + "// axis3: unused\n" + in + hex_array({0.0}, in) + ",\n";
+  std::vector<double> rm, rs;
+  for (const ResponseCell& c : r.cells) {
+    for (int k = 0; k < 3; ++k) {
+      rm.push_back(c.mean[static_cast<std::size_t>(k)]);
+      rs.push_back(c.std[static_cast<std::size_t>(k)]);
+    }
+  }
+  s += in + "// response_mean: per cell (cos theta slowest, then spin, then speed) w+ L/|V-|, dv_x/|V-|, dv_y/|V-|\n";
+  s += in + hex_array(rm, in) + ",\n";
+  s += in + "// response_stddev\n" + in + hex_array(rs, in) + ",\n";
+  std::vector<double> rn, rh, rf;
+  for (const RestCluster& c : kept) {
+    rn.push_back(c.normal.x);
+    rn.push_back(c.normal.y);
+    rh.push_back(c.height);
+    rf.push_back(c.frequency);
+  }
+  s += in + "// rest_normals: body-frame up vectors\n" + in + hex_array(rn, in) + ",\n";
+  s += in + "// rest_heights, m\n" + in + hex_array(rh, in) + ",\n";
+  s += in + "// rest_frequencies\n" + in + hex_array(rf, in) + ",\n";
+  s += "};\n\n}  // namespace statsim::tables\n";
+  return s;
+}
+
+std::string gather2d_json(const Gather2dResult& r, const std::string& command)
+{
+  const auto q = [](const std::string& x) {
+    std::string out = "\"";
+    for (char c : x) {
+      if (c == '"' || c == '\\') {
+        out += '\\';
+      }
+      out += c;
+    }
+    return out + "\"";
+  };
+  const auto num = [](double x) { return fmt("%.9g", x); };
+  std::string s = "{\n";
+  s += "  \"command\": " + q(command) + ",\n";
+  s += "  \"name\": " + q(r.options.name) + ",\n";
+  s += "  \"seed\": " + std::to_string(r.options.seed) + ",\n";
+  s += "  \"length\": " + num(r.length) + ",\n";
+  s += "  \"area\": " + num(r.shape.area) + ",\n";
+  s += "  \"seconds\": {\"heights\": " + num(r.seconds_heights) + ", \"responses\": " + num(r.seconds_responses) +
+       ", \"rest\": " + num(r.seconds_rest) + "},\n";
+  s += "  \"heights\": [";
+  for (std::size_t i = 0; i < r.heights.size(); ++i) {
+    const HeightRow& h = r.heights[i];
+    s += std::string(i ? "," : "") + "\n    {\"ratio\": " + num(h.ratio) + ", \"mean\": " + num(h.mean) +
+         ", \"std\": " + num(h.std) + ", \"min\": " + num(h.min) + ", \"max\": " + num(h.max) +
+         ", \"trials\": " + std::to_string(h.trials) + ", \"late\": " + std::to_string(h.late) +
+         ", \"missed\": " + std::to_string(h.missed) + "}";
+  }
+  s += "\n  ],\n";
+  s += "  \"response_trials\": " + std::to_string(r.response_trials) + ",\n";
+  s += "  \"response_time_limited\": " + std::to_string(r.response_time_limited) + ",\n";
+  s += "  \"cells\": [";
+  for (std::size_t i = 0; i < r.cells.size(); ++i) {
+    const ResponseCell& c = r.cells[i];
+    s += std::string(i ? "," : "") + "\n    {\"cos_theta\": " + num(c.cos_theta) + ", \"spin\": " + num(c.spin) +
+         ", \"speed\": " + num(c.speed) + ", \"mean\": [" + num(c.mean[0]) + ", " + num(c.mean[1]) + ", " +
+         num(c.mean[2]) + "], \"std\": [" + num(c.std[0]) + ", " + num(c.std[1]) + ", " + num(c.std[2]) +
+         "], \"time_limited\": " + std::to_string(c.time_limited) + ", \"mean_steps\": " + num(c.mean_steps) + "}";
+  }
+  s += "\n  ],\n";
+  s += "  \"rest_drops\": " + std::to_string(r.rest_drops) + ",\n";
+  s += "  \"rest_time_limited\": " + std::to_string(r.rest_time_limited) + ",\n";
+  s += "  \"rest_clusters\": [";
+  for (std::size_t i = 0; i < r.clusters.size(); ++i) {
+    const RestCluster& c = r.clusters[i];
+    s += std::string(i ? "," : "") + "\n    {\"normal\": [" + num(c.normal.x) + ", " + num(c.normal.y) +
+         "], \"height\": " + num(c.height) + ", \"frequency\": " + num(c.frequency) +
+         ", \"count\": " + std::to_string(c.count) + ", \"spread_degrees\": " + num(c.spread_degrees) +
+         ", \"snap_degrees\": " + num(c.snap_degrees) + ", \"kept\": " + (c.kept ? "true" : "false") + "}";
+  }
+  s += "\n  ]\n}\n";
+  return s;
+}
+
+std::string gather2d_summary(const Gather2dResult& r)
+{
+  std::string s = "gather2d " + r.options.name + ": " + r.shape.description + "\n";
+  s += "  L = " + g6(r.length) + " m, area " + g6(r.shape.area) + " m^2, " + std::to_string(r.shape.pieces.size()) +
+       " convex piece(s)\n";
+  s += "  height table (" + fmt("%.1f", r.seconds_heights) + " s):\n    s      mean      std       min       max\n";
+  for (const HeightRow& h : r.heights) {
+    s += "    " + fmt("%-5g", h.ratio) + "  " + fmt("%.5f", h.mean) + "  " + fmt("%.5f", h.std) + "  " +
+         fmt("%.5f", h.min) + "  " + fmt("%.5f", h.max) + "\n";
+  }
+  // Response: a digest over cells.
+  double max_abs_mean[3] = {0, 0, 0}, mean_std[3] = {0, 0, 0};
+  for (const ResponseCell& c : r.cells) {
+    for (int k = 0; k < 3; ++k) {
+      max_abs_mean[k] = std::max(max_abs_mean[k], std::fabs(c.mean[static_cast<std::size_t>(k)]));
+      mean_std[k] += c.std[static_cast<std::size_t>(k)] / static_cast<double>(r.cells.size());
+    }
+  }
+  s += "  response tables (" + fmt("%.1f", r.seconds_responses) + " s): " + std::to_string(r.cells.size()) +
+       " cells, " + std::to_string(r.response_trials) + " trials, " + std::to_string(r.response_time_limited) +
+       " hit the time limit\n";
+  s += "    max |mean| (w L/|V|, dv_x/|V|, dv_y/|V|) = (" + fmt("%.3f", max_abs_mean[0]) + ", " +
+       fmt("%.3f", max_abs_mean[1]) + ", " + fmt("%.3f", max_abs_mean[2]) + "), average std = (" +
+       fmt("%.3f", mean_std[0]) + ", " + fmt("%.3f", mean_std[1]) + ", " + fmt("%.3f", mean_std[2]) + ")\n";
+  s += "  rest poses (" + fmt("%.1f", r.seconds_rest) + " s): " + std::to_string(r.rest_drops) + " drops, " +
+       std::to_string(r.rest_time_limited) + " still awake at the time limit\n";
+  for (const RestCluster& c : r.clusters) {
+    s += std::string("    ") + (c.kept ? "kept " : "     ") + " up (" + fmt("%+.4f", c.normal.x) + ", " +
+         fmt("%+.4f", c.normal.y) + ")  h_rest " + fmt("%.5f", c.height) + " m  frequency " +
+         fmt("%.3f", c.frequency) + "  (" + std::to_string(c.count) + " drops, spread " +
+         fmt("%.2f", c.spread_degrees) + " deg" +
+         (c.snap_degrees >= 0 ? ", snapped " + fmt("%.3f", c.snap_degrees) + " deg" : std::string(", not snapped")) +
+         ")\n";
+  }
+  return s;
+}
+
+// ---- the command ---------------------------------------------------------------------------------
+
+namespace {
+
+struct Gather2dCommand {
+  Gather2dOptions options;
+  std::string out;
+  std::string json;
+  std::string name;
+  std::vector<std::pair<std::string, CLI::Option*>> recorded;  // options written into the command line
+  CLI::Option* shape_opt = nullptr;
+  CLI::Option* polygon_opt = nullptr;
+};
+
+std::string recorded_command(const Gather2dCommand& cmd)
+{
+  std::string s = "build/bin/statsim gather2d";
+  for (const auto& [flag, opt] : cmd.recorded) {
+    if (opt->count() == 0) {
+      continue;
+    }
+    for (const std::string& value : opt->results()) {
+      s += " " + flag + " " + shell_quote(value);
+    }
+  }
+  return s;
+}
+
+void run_gather2d_command(Gather2dCommand& cmd)
+{
+  try {
+    Gather2dOptions& o = cmd.options;
+    o.progress = true;
+    const bool has_shape = cmd.shape_opt->count() > 0;
+    const bool has_polygon = cmd.polygon_opt->count() > 0;
+    if (has_shape == has_polygon) {
+      throw std::invalid_argument("give exactly one of --shape square|lshape and --polygon \"x1,y1 x2,y2 ...\"");
+    }
+    if (has_polygon) {
+      o.shape = "polygon";
+    }
+    const std::filesystem::path out(cmd.out);
+    o.name = cmd.name.empty() ? out.stem().string() : cmd.name;
+    validate_gather2d_options(o);  // fail before a long run
+    const std::filesystem::path dir = out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
+    if (!std::filesystem::is_directory(dir)) {
+      throw std::invalid_argument("the directory of --out, '" + dir.string() + "', does not exist");
+    }
+    const std::string command = recorded_command(cmd);
+    const auto start = std::chrono::steady_clock::now();
+    const Gather2dResult r = run_gather2d(o);
+    const std::string header = gather2d_header(r, command);
+    write_file_atomic(out, header);
+    if (!cmd.json.empty()) {
+      write_file_atomic(cmd.json, gather2d_json(r, command));
+    }
+    std::fputs(gather2d_summary(r).c_str(), stdout);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("wrote %s (%zu bytes) in %.1f s\n", out.c_str(), header.size(), seconds);
+    std::fflush(stdout);
+  } catch (const std::exception& e) {
+    std::string message = e.what();
+    std::fprintf(stderr, "statsim gather2d: error: %s\n", message.c_str());
+    throw CLI::RuntimeError(1);
+  }
+}
+
+}  // namespace
+
+void register_gather2d_commands(CLI::App& app)
+{
+  auto cmd = std::make_shared<Gather2dCommand>();
+  Gather2dOptions& o = cmd->options;
+  CLI::App* g = app.add_subcommand(
+      "gather2d",
+      "Gather the statistical signature of a 2D shape with Box2D (collision heights, response tables, rest "
+      "poses) into a C++ header tables/NAME2d.hpp");
+  cmd->shape_opt = g->add_option("--shape", o.shape, "square (1 x 1 m) or lshape (1 m arms, 0.25 m thick)")
+                       ->check(CLI::IsMember({"square", "lshape"}));
+  cmd->polygon_opt = g->add_option("--polygon", o.polygon,
+                                   "A simple polygon \"x1,y1 x2,y2 ...\" in metres (concave allowed; either orientation)");
+  CLI::Option* out = g->add_option("--out", cmd->out, "Output header, e.g. tables/square2d.hpp")->required();
+  CLI::Option* name = g->add_option("--name", cmd->name, "C++ name of the table (default: the file name's stem)");
+  CLI::Option* seed = g->add_option("--seed", o.seed, "Random seed")->capture_default_str();
+  CLI::Option* trials =
+      g->add_option("--trials", o.trials, "Trials per response cell")->capture_default_str()->check(CLI::Range(2, 100000));
+  CLI::Option* height_trials = g->add_option("--height-trials", o.height_trials, "Drops per height-table spin ratio")
+                                   ->capture_default_str()
+                                   ->check(CLI::Range(2, 1000000));
+  CLI::Option* rest = g->add_option("--rest-drops", o.rest_drops, "Drops for the rest poses")
+                          ->capture_default_str()
+                          ->check(CLI::Range(20, 10000000));
+  CLI::Option* restitution = g->add_option("--restitution", o.restitution, "Restitution of body and ground")
+                                 ->capture_default_str()
+                                 ->check(CLI::Range(0.0, 1.0));
+  CLI::Option* friction = g->add_option("--friction", o.friction, "Friction of body and ground")
+                              ->capture_default_str()
+                              ->check(CLI::Range(0.0, 10.0));
+  g->add_option("--threads", o.threads, "Worker threads (0 = all); the output does not depend on it")
+      ->capture_default_str();
+  g->add_option("--json", cmd->json, "Also write a JSON summary (statistics, counts, timings) to this file");
+  cmd->recorded = {{"--shape", cmd->shape_opt},
+                   {"--polygon", cmd->polygon_opt},
+                   {"--out", out},
+                   {"--name", name},
+                   {"--seed", seed},
+                   {"--trials", trials},
+                   {"--height-trials", height_trials},
+                   {"--rest-drops", rest},
+                   {"--restitution", restitution},
+                   {"--friction", friction}};
+  g->callback([cmd]() { run_gather2d_command(*cmd); });
+
+  register_compare2d_command(app);
+}
+
+}  // namespace statsim::tools
