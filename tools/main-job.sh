@@ -15,3 +15,5 @@ run() {
 }
 run sphere_pile
 run drop2d --png "$out/drop2d.png"
+run drop_boxes
+run drop_lshapes

@@ -1,8 +1,10 @@
 // The `statsim` host command: one executable, one subcommand per job.
 #include <CLI/CLI.hpp>
 
+#include "bench/bench.hpp"
 #include "mesh/mesh_commands.hpp"
 #include "ref2d/ref2d.hpp"
+#include "ref3d/ref3d.hpp"
 
 int main(int argc, char** argv)
 {
@@ -11,6 +13,8 @@ int main(int argc, char** argv)
   app.set_version_flag("--version", "statsim 0.1.0");
   statsim::tools::register_mesh_commands(app);
   statsim::tools::register_ref2d_commands(app);
+  statsim::tools::register_bench_commands(app);
+  statsim::tools::register_ref3d_commands(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

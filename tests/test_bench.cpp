@@ -1,0 +1,303 @@
+// The shared drop scenes (tools/scenes) and `statsim bench` on a tiny configuration. Whole-scene
+// timing is a benchmark, not a test: nothing here asserts a time beyond "finite and positive".
+#include "bench/bench.hpp"
+#include "scenes/scenes.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace statsim::tools;
+
+namespace {
+
+scenes::DropOptions options(int n, std::uint64_t seed = 7)
+{
+  scenes::DropOptions o;
+  o.count = n;
+  o.bounding_radius = 0.1608;
+  o.seed = seed;
+  return o;
+}
+
+bool same(const scenes::BodyState3& a, const scenes::BodyState3& b)
+{
+  return a.position == b.position && a.orientation.coeffs() == b.orientation.coeffs() &&
+         a.linear_velocity == b.linear_velocity && a.angular_velocity == b.angular_velocity;
+}
+
+// Splits a CSV line into fields (double quotes protect commas; "" is a quote).
+std::vector<std::string> csv_fields(const std::string& line)
+{
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        out.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> lines_of(const std::string& text)
+{
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(line);
+  return lines;
+}
+
+void check_cells(const BenchResult& r)
+{
+  for (const BenchCell& c : r.cells) {
+    INFO(c.method << "/" << c.broadphase << " N=" << c.n << ": " << c.note);
+    REQUIRE_FALSE(c.skipped);
+    CHECK(c.repeats == r.options.repeats);
+    CHECK(std::isfinite(c.step_ms_median));
+    CHECK(c.step_ms_median > 0);
+    CHECK(c.step_ms_min > 0);
+    CHECK(c.step_ms_min <= c.step_ms_median);
+    CHECK(c.step_ms_median <= c.step_ms_max);
+    CHECK(c.step_ms_envelope > 0);
+    CHECK(c.step_ms_envelope <= c.step_ms_min * (1 + 1e-12));  // the envelope is below every repeat
+    CHECK(std::isfinite(c.mean_height_end));
+    if (c.engine == "statsim") {
+      CHECK(c.collision_ms < 0);  // n/a
+    } else {
+      CHECK(c.collision_ms >= 0);
+      CHECK(std::isfinite(c.response_ms));
+    }
+  }
+}
+
+void check_csv(const BenchResult& r)
+{
+  const std::vector<std::string> lines = lines_of(bench_csv(r));
+  REQUIRE(lines.size() == r.cells.size() + 1);
+  const std::vector<std::string> header = csv_fields(lines[0]);
+  const char* required[] = {"method", "n", "broadphase", "step_ms_median", "step_ms_min",
+                            "step_ms_max", "collision_ms", "response_ms"};
+  REQUIRE(header.size() >= 8);
+  for (std::size_t i = 0; i < 8; ++i) CHECK(header[i] == required[i]);
+  for (std::size_t k = 1; k < lines.size(); ++k) {
+    const std::vector<std::string> f = csv_fields(lines[k]);
+    REQUIRE(f.size() == header.size());
+    CHECK(f[0] == r.cells[k - 1].method);
+    CHECK(std::stoi(f[1]) == r.cells[k - 1].n);
+    const double t = std::stod(f[3]);
+    CHECK(std::isfinite(t));
+    CHECK(t > 0);
+  }
+}
+
+void check_markdown(const BenchResult& r)
+{
+  const std::string md = bench_markdown(r);
+  CHECK(md.find("| N | type |") != std::string::npos);
+  CHECK(md.find("one step") != std::string::npos);
+  CHECK(md.find("collision") != std::string::npos);
+  CHECK(md.find("response") != std::string::npos);
+  CHECK(md.find("## Settings") != std::string::npos);
+  // Every table row has as many cells as its header.
+  std::size_t header_bars = 0;
+  for (const std::string& line : lines_of(md)) {
+    if (line.rfind("| N | type |", 0) == 0) header_bars = static_cast<std::size_t>(std::count(line.begin(), line.end(), '|'));
+    if (line.empty()) header_bars = 0;
+    if (header_bars && line.rfind("|", 0) == 0)
+      CHECK(static_cast<std::size_t>(std::count(line.begin(), line.end(), '|')) == header_bars);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("drop scene 3D is deterministic and differs between seeds")
+{
+  const scenes::DropScene3 a = scenes::drop_scene3(options(200));
+  const scenes::DropScene3 b = scenes::drop_scene3(options(200));
+  const scenes::DropScene3 c = scenes::drop_scene3(options(200, 8));
+  REQUIRE(a.bodies.size() == 200);
+  REQUIRE(b.bodies.size() == 200);
+  bool all_same = true, any_differs = false;
+  for (std::size_t i = 0; i < a.bodies.size(); ++i) {
+    all_same = all_same && same(a.bodies[i], b.bodies[i]);
+    any_differs = any_differs || !same(a.bodies[i], c.bodies[i]);
+  }
+  CHECK(all_same);
+  CHECK(any_differs);
+  CHECK(a.region.radius == b.region.radius);
+  CHECK(a.region.height == b.region.height);
+}
+
+TEST_CASE("drop scene 3D places bodies inside the cylinder without overlap")
+{
+  for (int n : {1, 10, 100, 1000}) {
+    INFO("N = " << n);
+    const scenes::DropScene3 s = scenes::drop_scene3(options(n));
+    const double r = s.options.bounding_radius, tol = 1e-9;
+    REQUIRE(s.bodies.size() == static_cast<std::size_t>(n));
+    for (const scenes::BodyState3& b : s.bodies) {
+      CHECK(std::hypot(b.position.x(), b.position.y()) + r <= s.region.radius + tol);
+      CHECK(b.position.z() - r >= s.region.bottom - tol);
+      CHECK(b.position.z() + r <= s.region.bottom + s.region.height + tol);
+      CHECK(b.position.z() - r > 0);  // above the ground
+      CHECK(std::fabs(b.orientation.norm() - 1) < 1e-12);
+      CHECK(b.linear_velocity.cwiseAbs().maxCoeff() <= s.options.max_speed);
+      CHECK(b.angular_velocity.cwiseAbs().maxCoeff() <= s.options.max_spin);
+      for (int a = 0; a < 3; ++a) {
+        CHECK(b.position[a] > s.bounds_lo[a]);
+        CHECK(b.position[a] < s.bounds_hi[a]);
+      }
+    }
+    // Bounding spheres do not overlap.
+    CHECK(scenes::min_centre_distance(s.bodies, s.cell) >= 2 * r - tol);
+  }
+}
+
+TEST_CASE("drop scene region grows with N")
+{
+  double last_radius = 0, last_height = 0;
+  for (int n : {10, 100, 1000, 10000}) {
+    const scenes::DropScene3 s = scenes::drop_scene3(options(n));
+    CHECK(s.region.radius >= last_radius);
+    CHECK(s.region.height >= last_height);
+    last_radius = s.region.radius;
+    last_height = s.region.height;
+  }
+  // N^(1/3) growth: 1000 times the bodies, about 10 times the radius (not 1000, not 30).
+  const double ratio = scenes::drop_scene3(options(10000)).region.radius / scenes::drop_scene3(options(10)).region.radius;
+  CHECK(ratio > 4);
+  CHECK(ratio < 12);
+}
+
+TEST_CASE("drop scene 2D is deterministic and places bodies without overlap")
+{
+  scenes::DropOptions o = options(300);
+  o.bounding_radius = 0.70710678118654752;
+  const scenes::DropScene2 a = scenes::drop_scene2(o);
+  const scenes::DropScene2 b = scenes::drop_scene2(o);
+  REQUIRE(a.bodies.size() == 300);
+  const double r = o.bounding_radius, tol = 1e-9;
+  for (std::size_t i = 0; i < a.bodies.size(); ++i) {
+    const scenes::BodyState2& p = a.bodies[i];
+    CHECK(p.position == b.bodies[i].position);
+    CHECK(p.angle == b.bodies[i].angle);
+    CHECK(std::fabs(p.position.x()) + r <= a.region.half_width + tol);
+    CHECK(p.position.y() - r >= a.region.bottom - tol);
+    CHECK(p.position.y() + r <= a.region.bottom + a.region.height + tol);
+  }
+  CHECK(scenes::min_centre_distance(a.bodies, a.cell) >= 2 * r - tol);
+}
+
+TEST_CASE("drop scene rejects bad options")
+{
+  scenes::DropOptions o = options(0);
+  CHECK_THROWS_AS(scenes::drop_scene3(o), std::invalid_argument);
+  o = options(10);
+  o.bounding_radius = -1;
+  CHECK_THROWS_AS(scenes::drop_scene3(o), std::invalid_argument);
+  o = options(10);
+  o.fill = 0;
+  CHECK_THROWS_AS(scenes::drop_scene2(o), std::invalid_argument);
+}
+
+TEST_CASE("bench 3D tiny configuration runs every method")
+{
+  BenchOptions o;
+  o.dim = 3;
+  o.counts = {10};
+  o.methods = {"full", "low", "hull", "spheres7", "sphere", "statistical"};
+  o.broadphases = {"sap", "dbvt"};
+  o.steps = 4;
+  o.warmup = 1;
+  o.repeats = 2;
+  o.allow_synthetic = true;  // the bunny table may not be generated yet
+  o.progress = false;
+  const BenchResult r = run_bench(o);
+  CHECK(r.cells.size() == 5 * 2 + 1);
+  check_cells(r);
+  check_csv(r);
+  check_markdown(r);
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "statsim_test_bench";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path png = dir / "bench.png";
+  write_bench_chart(r, png);
+  CHECK(std::filesystem::file_size(png) > 1000);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("bench 2D tiny configuration runs every method")
+{
+  BenchOptions o;
+  o.dim = 2;
+  o.shape = "square";
+  o.counts = {10};
+  o.steps = 4;
+  o.warmup = 1;
+  o.repeats = 1;
+  o.allow_synthetic = true;
+  o.progress = false;
+  const BenchResult r = run_bench(o);
+  // polygon, circle, statistical, and statsim's other broad phase when the runtime has a choice.
+  CHECK(r.cells.size() >= 3);
+  check_cells(r);
+  check_csv(r);
+  check_markdown(r);
+}
+
+TEST_CASE("bench skips a cell over the step limit and says why")
+{
+  BenchOptions o;
+  o.counts = {10, 20};
+  o.methods = {"full"};
+  o.broadphases = {"sap"};
+  o.steps = 12;
+  o.warmup = 1;
+  o.repeats = 1;
+  o.limit_ms = 1e-6;  // every step is over it
+  o.progress = false;
+  const BenchResult r = run_bench(o);
+  REQUIRE(r.cells.size() == 2);
+  for (const BenchCell& c : r.cells) {
+    CHECK(c.skipped);
+    CHECK(c.note.find("limit") != std::string::npos);
+  }
+  CHECK(bench_markdown(r).find("skipped") != std::string::npos);
+}
+
+TEST_CASE("bench rejects bad options")
+{
+  BenchOptions o;
+  o.methods = {"nonsense"};
+  CHECK_THROWS_AS(validate_bench_options(o), std::invalid_argument);
+  o = BenchOptions{};
+  o.broadphases = {"octree"};
+  CHECK_THROWS_AS(validate_bench_options(o), std::invalid_argument);
+  o = BenchOptions{};
+  o.counts = {0};
+  CHECK_THROWS_AS(validate_bench_options(o), std::invalid_argument);
+  o = BenchOptions{};
+  o.dt = -1;
+  CHECK_THROWS_AS(validate_bench_options(o), std::invalid_argument);
+}

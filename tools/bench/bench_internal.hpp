@@ -1,0 +1,140 @@
+// Internals of `statsim bench`: one interface for every simulated method, and the factories of
+// the engines (Bullet, Box2D, statsim). Not installed; only tools/bench and its test use it.
+#pragma once
+
+#include "bench/bench.hpp"
+#include "scenes/scenes.hpp"
+
+#include <Eigen/Core>
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace statsim::tools::bench {
+
+using Clock = std::chrono::steady_clock;
+
+inline std::int64_t elapsed_ns(Clock::time_point a, Clock::time_point b)
+{
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
+}
+
+/// Phase times of the last step, ns; negative when the engine does not report them.
+struct PhaseTimes {
+  std::int64_t broad = -1;   ///< broad phase (AABB update and pair search)
+  std::int64_t narrow = -1;  ///< narrow phase (contact generation)
+  std::int64_t collision() const { return broad < 0 || narrow < 0 ? -1 : broad + narrow; }
+};
+
+/// What a world looks like after a run (not timed): for sanity checks across methods.
+struct EndState {
+  std::size_t asleep = 0;
+  double mean_height = 0.0;  ///< mean of the centres' up coordinate, m
+  std::size_t contacts = 0;  ///< touching pairs (body-body and body-ground) the engine reports
+};
+
+/// One simulated world of one method, built from a scene. `step()` is what is timed.
+class Sim {
+public:
+  virtual ~Sim() = default;
+  virtual void step() = 0;
+  virtual PhaseTimes phases() const { return {}; }
+  /// Bodies asleep now (called between steps, not timed).
+  virtual std::size_t asleep() const = 0;
+  virtual EndState end_state() const = 0;
+  /// Problems of the last step worth a note in the report (e.g. a full pair buffer); empty if none.
+  virtual std::string warning() const { return {}; }
+};
+
+/// Material and thresholds every method uses, from the statistical table (or defaults).
+struct Surface {
+  double restitution = 0.3;
+  double friction = 0.5;
+  double rolling_resistance = 0.05;   ///< statsim's dimensionless rolling resistance
+  double restitution_threshold = 0.5; ///< m/s: the statsim world's (WorldDef::restitution_threshold)
+  double sleep_speed = 0.05;          ///< m/s: statsim's WorldDef::sleep_speed (speed = max(|v|, |w| R))
+  double sleep_time = 0.5;            ///< s: statsim's WorldDef::sleep_time
+};
+
+/// The 3D body: its geometry in the body frame (centre of mass, principal axes of the full mesh;
+/// the same frame for every representation), mass properties and what the table says.
+struct Body3 {
+  std::string shape;                      ///< bunny, box, lshape
+  std::vector<Eigen::Vector3d> full_vertices;
+  std::vector<int> full_indices;          ///< 3 per triangle
+  std::vector<Eigen::Vector3d> low_vertices;  ///< bunny_low.obj, in the full mesh's body frame
+  std::vector<int> low_indices;
+  std::vector<Eigen::Vector4d> spheres;   ///< bunny_spheres7.txt: centre (body frame), radius
+  /// Boxes of box-built shapes (box: one; lshape: two): centre, rotation (columns: box axes in
+  /// the body frame), half extents.
+  struct Box {
+    Eigen::Vector3d centre;
+    Eigen::Matrix3d rotation;
+    Eigen::Vector3d half_extents;
+  };
+  std::vector<Box> boxes;
+  double bounding_radius = 0.0;           ///< m, of the full mesh about its centre of mass
+  double mass = 0.0;                      ///< kg (the table's, or density 1000 x volume)
+  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();  ///< principal moments, kg m^2
+  double sphere_radius = 0.0;             ///< radius of the `sphere` method, m
+  std::string sphere_radius_note;         ///< where it comes from
+  Surface surface;
+  bool has_table = false;                 ///< a statistical table is compiled in for the shape
+  bool synthetic_table = false;           ///< the table is tests/synthetic_signature.hpp's cube
+  std::string table_name;
+};
+
+/// The 2D body: the unit square.
+struct Body2 {
+  double half_side = 0.5;
+  double bounding_radius = 0.70710678118654752;
+  double mass = 1.0;
+  double circle_radius = 0.0;
+  std::string circle_radius_note;
+  Surface surface;
+  bool has_table = false;
+  bool synthetic_table = false;
+  std::string table_name;
+};
+
+// ---- statsim (bench_statsim.cpp) -----------------------------------------------------------------
+/// Fills the table-derived fields of `body` (has_table, mass, sphere radius, surface) for
+/// `shape`; `allow_synthetic` uses the synthetic cube when the shape's table is missing.
+void describe_table3(const std::string& shape, bool allow_synthetic, Body3& body);
+void describe_table2(bool allow_synthetic, Body2& body);
+/// Largest N the statsim worlds of the benchmark hold.
+std::uint32_t statsim_capacity();
+/// True when this runtime lets WorldDef choose its broad phase (grid or sweep-and-prune).
+bool statsim_has_broad_phase_switch();
+/// The runtime's default broad phase: "grid" or "sap".
+std::string statsim_default_broad_phase();
+/// `broad_phase`: "" = the runtime's default, "grid" or "sap" (sweep-and-prune).
+std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
+                                   const std::string& broad_phase);
+std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,
+                                   const std::string& broad_phase);
+
+// ---- Bullet (bench_bullet.cpp) ------------------------------------------------------------------
+/// Shapes shared by every Bullet world of a run (built once).
+class BulletShapes;
+std::shared_ptr<BulletShapes> make_bullet_shapes(const Body3& body);
+/// True when `method` can be built for the body (e.g. spheres7 needs the sphere file).
+bool bullet_supports(const BulletShapes& shapes, const std::string& method, std::string& why_not);
+std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
+                                 const std::string& broadphase, const scenes::DropScene3& scene, double dt);
+/// Every Bullet setting the benchmark makes, one per line, for the report.
+std::vector<std::string> bullet_settings(const Body3& body);
+
+// ---- Box2D (bench_box2d.cpp) --------------------------------------------------------------------
+std::unique_ptr<Sim> make_box2d(const Body2& body, const std::string& method, const scenes::DropScene2& scene,
+                                double dt);
+std::vector<std::string> box2d_settings(const Body2& body);
+
+// ---- loading (bench.cpp) -------------------------------------------------------------------------
+/// Loads the meshes of `shape` from `meshes_dir` into the body frame. Throws std::runtime_error.
+Body3 load_body3(const std::string& shape, const std::string& meshes_dir, bool allow_synthetic);
+
+}  // namespace statsim::tools::bench

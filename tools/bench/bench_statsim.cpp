@@ -1,0 +1,285 @@
+// The `statistical` method: statsim worlds (World3 / World2) with the shape's generated table,
+// the runtime's defaults (WorldDef), a ground plane and the scene's initial states.
+#include "bench/bench_internal.hpp"
+
+#include "statsim/world2.hpp"
+#include "statsim/world3.hpp"
+
+// Tables are compiled in when they exist, so the tool builds before they are generated.
+#if __has_include("tables/bunny.hpp")
+#include "tables/bunny.hpp"
+#define STATSIM_BENCH_HAVE_BUNNY 1
+#endif
+#if __has_include("tables/box.hpp")
+#include "tables/box.hpp"
+#define STATSIM_BENCH_HAVE_BOX 1
+#endif
+#if __has_include("tables/lshape.hpp")
+#include "tables/lshape.hpp"
+#define STATSIM_BENCH_HAVE_LSHAPE 1
+#endif
+#if __has_include("tables/square2d.hpp")
+#include "tables/square2d.hpp"
+#define STATSIM_BENCH_HAVE_SQUARE2D 1
+#endif
+#include "../../tests/synthetic_signature.hpp"
+
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+namespace statsim::tools::bench {
+namespace {
+
+// Capacities: the world is sized to the scene (the smallest of these tiers that holds N), as a user
+// would size it; candidate pairs up to 32 per body (bounding spheres of a pile of bunnies overlap
+// about a dozen neighbours each; an overflow is reported, never silent).
+constexpr std::uint32_t kCapacity = 32768;
+constexpr std::uint32_t kPairsPerBody = 32;
+
+// The runtime's broad-phase switch (WorldDef::broad_phase), when this runtime has one.
+template <class Def, class = void>
+struct HasBroadPhase : std::false_type {};
+template <class Def>
+struct HasBroadPhase<Def, std::void_t<decltype(std::declval<Def&>().broad_phase)>> : std::true_type {};
+
+/// Sets the broad phase: "" keeps the runtime's default; "grid" or "sap" forces one.
+template <class Def>
+void set_broad_phase(Def& def, const std::string& which)
+{
+  if (which.empty()) return;
+  if constexpr (HasBroadPhase<Def>::value) {
+    using Kind = decltype(def.broad_phase);
+    def.broad_phase = which == "grid" ? Kind::grid : Kind::sweep_and_prune;
+  } else if (which != "sap") {
+    throw std::runtime_error("this statsim runtime has no " + which + " broad phase");
+  }
+}
+
+struct Table3 {
+  SignatureView<3> view;
+  bool synthetic = false;
+};
+
+std::optional<Table3> table3(const std::string& shape, bool allow_synthetic)
+{
+  (void)shape;  // unused when no 3D table is generated yet
+#ifdef STATSIM_BENCH_HAVE_BUNNY
+  if (shape == "bunny") return Table3{tables::bunny.view(), false};
+#endif
+#ifdef STATSIM_BENCH_HAVE_BOX
+  if (shape == "box") return Table3{tables::box.view(), false};
+#endif
+#ifdef STATSIM_BENCH_HAVE_LSHAPE
+  if (shape == "lshape") return Table3{tables::lshape.view(), false};
+#endif
+  if (allow_synthetic) return Table3{testing::cube_synthetic.view(), true};
+  return std::nullopt;
+}
+
+std::optional<SignatureView<2>> view2(bool allow_synthetic)
+{
+#ifdef STATSIM_BENCH_HAVE_SQUARE2D
+  (void)allow_synthetic;
+  return tables::square2d.view();
+#else
+  if (allow_synthetic) return testing::square2d_synthetic.view();
+  return std::nullopt;
+#endif
+}
+
+bool view2_synthetic()
+{
+#ifdef STATSIM_BENCH_HAVE_SQUARE2D
+  return false;
+#else
+  return true;
+#endif
+}
+
+template <int D>
+void fill_surface(const SignatureView<D>& sig, Surface& s)
+{
+  const WorldDef<D> def{};
+  s.restitution = sig.material.restitution;
+  s.friction = sig.material.friction;
+  s.rolling_resistance = sig.material.rolling_resistance;
+  s.restitution_threshold = def.restitution_threshold;
+  s.sleep_speed = def.sleep_speed;
+  s.sleep_time = def.sleep_time;
+}
+
+template <int D>
+void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::BodyState3& s)
+{
+  BodyDef<D> b;
+  b.position = s.position.cast<Scalar>();
+  b.orientation = s.orientation.cast<Scalar>().normalized();
+  b.linear_velocity = s.linear_velocity.cast<Scalar>();
+  b.angular_velocity = s.angular_velocity.cast<Scalar>();
+  b.shape = shape;
+  b.mass = static_cast<Scalar>(mass);
+  const Added<BodyId> added = world.add_body(b);
+  if (!added.ok()) throw std::runtime_error(std::string("statsim add_body: ") + to_string(added.status));
+}
+
+template <int D>
+void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::BodyState2& s)
+{
+  BodyDef<D> b;
+  b.position = s.position.cast<Scalar>();
+  b.orientation = Rot2{static_cast<Scalar>(std::cos(s.angle)), static_cast<Scalar>(std::sin(s.angle))};
+  b.linear_velocity = s.linear_velocity.cast<Scalar>();
+  b.angular_velocity = static_cast<Scalar>(s.angular_velocity);
+  b.shape = shape;
+  b.mass = static_cast<Scalar>(mass);
+  const Added<BodyId> added = world.add_body(b);
+  if (!added.ok()) throw std::runtime_error(std::string("statsim add_body: ") + to_string(added.status));
+}
+
+/// A statsim world of capacity `Cap` with the scene's bodies and the ground.
+template <int D, std::uint32_t Cap>
+class StatsimSim final : public Sim {
+public:
+  using WorldT = World<D, Cap, 4, Cap * kPairsPerBody, 2>;
+
+  template <class Scene>
+  StatsimSim(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed, double dt,
+             const std::string& broad_phase)
+      : dt_(static_cast<Scalar>(dt))
+  {
+    WorldDef<D> def;
+    def.seed = seed;
+    set_broad_phase(def, broad_phase);
+    world_ = std::make_unique<WorldT>(def);
+    if (world_->construction_status() != Status::ok)
+      throw std::runtime_error(std::string("statsim world: ") + to_string(world_->construction_status()));
+    const Added<ShapeId> shape = world_->add_shape(sig);
+    if (!shape.ok()) throw std::runtime_error(std::string("statsim add_shape: ") + to_string(shape.status));
+    world_->add_plane(Space<D>::Vec::Unit(Space<D>::up_axis), 0);
+    for (const auto& s : scene.bodies) add_body<D>(*world_, shape.id, mass, s);
+  }
+  void step() override
+  {
+    last_ = world_->step(dt_);
+    if (last_.pairs_dropped > worst_dropped_) worst_dropped_ = last_.pairs_dropped;
+  }
+  std::size_t asleep() const override { return world_->count(MotionState::asleep); }
+  EndState end_state() const override
+  {
+    EndState e;
+    e.asleep = asleep();
+    double h = 0;
+    for (std::uint32_t i = 0; i < world_->body_count(); ++i)
+      h += double(world_->body(i).position[Space<D>::up_axis]);
+    e.mean_height = world_->body_count() ? h / world_->body_count() : 0.0;
+    e.contacts = last_.contacts;
+    return e;
+  }
+  std::string warning() const override
+  {
+    if (worst_dropped_ == 0) return {};
+    return "statsim pair buffer full: up to " + std::to_string(worst_dropped_) + " candidate pairs dropped in a step";
+  }
+
+private:
+  std::unique_ptr<WorldT> world_;
+  Scalar dt_;
+  StepResult last_{};
+  std::uint32_t worst_dropped_ = 0;
+};
+
+template <int D, class Scene>
+std::unique_ptr<Sim> make_sized(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed,
+                                double dt, const std::string& broad_phase)
+{
+  const std::size_t n = scene.bodies.size();
+  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, mass, scene, seed, dt, broad_phase);
+  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, mass, scene, seed, dt, broad_phase);
+  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, mass, scene, seed, dt, broad_phase);
+  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, mass, scene, seed, dt, broad_phase);
+  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, mass, scene, seed, dt, broad_phase);
+  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, mass, scene, seed, dt, broad_phase);
+  throw std::runtime_error("statsim bench worlds hold at most " + std::to_string(kCapacity) + " bodies");
+}
+
+}  // namespace
+
+std::uint32_t statsim_capacity()
+{
+  return kCapacity;
+}
+
+void describe_table3(const std::string& shape, bool allow_synthetic, Body3& body)
+{
+  const std::optional<Table3> t = table3(shape, allow_synthetic);
+  body.has_table = t.has_value();
+  if (!t) {
+    body.table_name = "tables/" + shape + ".hpp (missing)";
+    return;
+  }
+  body.synthetic_table = t->synthetic;
+  body.table_name = t->synthetic ? "tests/synthetic_signature.hpp cube_synthetic (stand-in: tables/" + shape +
+                                       ".hpp is missing)"
+                                 : "tables/" + shape + ".hpp";
+  fill_surface<3>(t->view, body.surface);
+  if (!t->synthetic) body.mass = static_cast<double>(t->view.mass);
+  body.sphere_radius = static_cast<double>(t->view.height.mean[0]);
+  body.sphere_radius_note = "the table's mean collision radius h_coll at spin ratio 0";
+  if (t->synthetic) body.sphere_radius_note += " (synthetic cube table)";
+}
+
+void describe_table2(bool allow_synthetic, Body2& body)
+{
+  const std::optional<SignatureView<2>> v = view2(allow_synthetic);
+  body.has_table = v.has_value();
+  if (!v) {
+    body.table_name = "tables/square2d.hpp (missing)";
+    return;
+  }
+  body.synthetic_table = view2_synthetic();
+  body.table_name = body.synthetic_table
+                        ? "tests/synthetic_signature.hpp square2d_synthetic (stand-in: tables/square2d.hpp is missing)"
+                        : "tables/square2d.hpp";
+  fill_surface<2>(*v, body.surface);
+  body.mass = static_cast<double>(v->mass);
+  body.circle_radius = static_cast<double>(v->height.mean[0]);
+  body.circle_radius_note = "the table's mean collision radius h_coll at spin ratio 0";
+}
+
+bool statsim_has_broad_phase_switch()
+{
+  return HasBroadPhase<WorldDef3>::value;
+}
+
+std::string statsim_default_broad_phase()
+{
+  if constexpr (HasBroadPhase<WorldDef3>::value) {
+    using Kind = decltype(WorldDef3{}.broad_phase);
+    return WorldDef3{}.broad_phase == Kind::grid ? "grid" : "sap";
+  } else {
+    return "sap";
+  }
+}
+
+std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
+                                   const std::string& broad_phase)
+{
+  const std::optional<Table3> t = table3(body.shape, body.synthetic_table);
+  if (!t) throw std::runtime_error("no statistical table for " + body.shape);
+  return make_sized<3>(t->view, body.mass, scene, seed, dt, broad_phase);
+}
+
+std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,
+                                   const std::string& broad_phase)
+{
+  const std::optional<SignatureView<2>> v = view2(body.synthetic_table);
+  if (!v) throw std::runtime_error("no statistical table for the square");
+  return make_sized<2>(*v, body.mass, scene, seed, dt, broad_phase);
+}
+
+}  // namespace statsim::tools::bench

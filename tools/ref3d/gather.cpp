@@ -1,0 +1,1101 @@
+#include "ref3d/gather.hpp"
+
+#include "common/parallel.hpp"
+#include "common/progress.hpp"
+#include "ref3d/sampling.hpp"
+#include "statsim/response.hpp"
+#include "statsim/signature.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+namespace statsim::tools::ref3d {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Random streams (TrialRng's `stream`): one per kind of trial.
+constexpr std::uint64_t kHeightStream = 1;
+constexpr std::uint64_t kResponseStream = 2;
+constexpr std::uint64_t kRestStream = 3;
+constexpr std::uint64_t kCheckStream = 5;
+// Rest normals within this angle of a hull face's are snapped to it.
+constexpr double kSnapDegrees = 3.0;
+
+std::string fmt(const char* f, double x)
+{
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, x);
+  return buf;
+}
+
+// Shortest decimal that reads back to the same double (for comments and recorded options).
+std::string num(double x)
+{
+  char buf[64];
+  if (x == std::floor(x) && std::fabs(x) < 1e15) {
+    std::snprintf(buf, sizeof buf, "%.0f", x + 0.0);
+    return buf;
+  }
+  for (int p = 1; p <= 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*g", p, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+// A pool of Reference objects, one per worker at most: a task borrows one and gives it back.
+// Trials build a fresh Bullet world each, so which object runs a trial does not matter.
+class ReferencePool {
+public:
+  ReferencePool(const ShapeModel& m, const ReferenceSettings& s) : model_(m), settings_(s) {}
+  template <class F>
+  auto with(F&& f)
+  {
+    std::unique_ptr<Reference> ref;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!free_.empty()) {
+        ref = std::move(free_.back());
+        free_.pop_back();
+      }
+    }
+    if (!ref) ref = std::make_unique<Reference>(model_, settings_);
+    struct Return {
+      ReferencePool& pool;
+      std::unique_ptr<Reference>& ref;
+      ~Return()
+      {
+        std::lock_guard<std::mutex> lock(pool.mutex_);
+        pool.free_.push_back(std::move(ref));
+      }
+    } give_back{*this, ref};
+    return f(*ref);
+  }
+
+private:
+  const ShapeModel& model_;
+  ReferenceSettings settings_;
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<Reference>> free_;
+};
+
+struct Stats {
+  double mean = 0.0, std = 0.0;
+};
+template <class Get>
+Stats stats(std::size_t n, Get&& get)
+{
+  Stats s;
+  if (n == 0) return s;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) sum += get(i);
+  s.mean = sum / static_cast<double>(n);
+  if (n < 2) return s;
+  double sq = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = get(i) - s.mean;
+    sq += d * d;
+  }
+  s.std = std::sqrt(sq / static_cast<double>(n - 1));
+  return s;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+bool strictly_increasing(const std::vector<double>& v)
+{
+  for (std::size_t i = 1; i < v.size(); ++i)
+    if (!(v[i] > v[i - 1])) return false;
+  return true;
+}
+
+bool valid_identifier(const std::string& s)
+{
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+}  // namespace
+
+// ---- axes ------------------------------------------------------------------------------------
+
+std::vector<double> default_height_ratios()
+{
+  return {0, 0.25, 0.5, 1, 1.5, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64};
+}
+std::vector<double> default_cos_theta()
+{
+  return {0.1, 0.25, 0.4, 0.55, 0.7, 0.85, 1};
+}
+std::vector<double> default_cos_phi()
+{
+  std::vector<double> v;
+  for (int i = 0; i < 10; ++i) v.push_back(i == 9 ? 1.0 : -1.0 + 2.0 * i / 9.0);
+  return v;
+}
+std::vector<double> default_spin_ratios()
+{
+  return {0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.65, 0.8, 1, 1.25, 1.5, 2, 3, 4, 6, 8};
+}
+std::vector<double> default_paper_speeds()
+{
+  // 26 speeds, geometric from 0.25 to 12 m/s, rounded to 3 significant digits.
+  std::vector<double> v;
+  for (int i = 0; i < 26; ++i) {
+    const double x = 0.25 * std::pow(12.0 / 0.25, i / 25.0);
+    v.push_back(std::strtod(fmt("%.3g", x).c_str(), nullptr));
+  }
+  return v;
+}
+std::vector<double> default_coarse_speeds()
+{
+  return {0.5, 1, 2, 4, 8};
+}
+
+void validate_gather_options(const GatherOptions& o)
+{
+  auto fail = [](const std::string& m) { throw std::runtime_error(m); };
+  if (!o.name.empty() && !valid_identifier(o.name)) fail("--name '" + o.name + "' is not a C++ identifier");
+  if (o.trials < 2) fail("--trials must be at least 2");
+  if (o.height_trials < 2) fail("--height-trials must be at least 2");
+  if (o.rest_drops < 1) fail("--rest-drops must be at least 1");
+  if (!(o.speed > 0) || !std::isfinite(o.speed)) fail("--speed must be positive");
+  if (!(o.density > 0) || !std::isfinite(o.density)) fail("--density must be positive");
+  const ReferenceSettings& r = o.reference;
+  if (!(r.dt > 0) || r.dt > 0.1) fail("--dt must be in (0, 0.1] s");
+  if (!(r.restitution >= 0 && r.restitution <= 1)) fail("--restitution must be in [0, 1]");
+  if (!(r.friction >= 0) || !std::isfinite(r.friction)) fail("--friction must be >= 0");
+  if (!(r.restitution_threshold >= 0) || !std::isfinite(r.restitution_threshold))
+    fail("--restitution-threshold must be >= 0");
+  if (!(r.margin > 0) || !std::isfinite(r.margin)) fail("--margin must be positive");
+  if (r.solver_iterations < 1) fail("--solver-iterations must be at least 1");
+  if (!(o.rolling_resistance >= 0)) fail("--rolling-resistance must be >= 0");
+  if (!(o.rest_tolerance_deg > 0 && o.rest_tolerance_deg < 90)) fail("--rest-tolerance must be in (0, 90) degrees");
+  if (!(o.rest_min_frequency >= 0 && o.rest_min_frequency < 1)) fail("--rest-min-frequency must be in [0, 1)");
+  if (!(o.max_impact_time > 0) || !(o.max_drop_time > 0) || !(o.still_time > 0) || !(o.still_speed > 0))
+    fail("time limits and the stillness threshold must be positive");
+  auto axis = [&](const std::vector<double>& v, const char* what, double lo, double hi) {
+    if (v.empty()) fail(std::string(what) + ": needs at least one sample");
+    if (!strictly_increasing(v)) fail(std::string(what) + ": samples must be strictly increasing");
+    if (!(v.front() >= lo) || !(v.back() <= hi)) fail(std::string(what) + ": samples must lie in [" + num(lo) + ", " + num(hi) + "]");
+  };
+  if (!o.box_size.empty()) {
+    if (o.box_size.size() != 3) fail("--box-size needs three values X,Y,Z");
+    for (double x : o.box_size)
+      if (!(x > 0) || !std::isfinite(x)) fail("--box-size: sizes must be positive");
+  }
+  axis(o.height_ratios, "height ratios", 0, 1e6);
+  axis(o.cos_theta, "cos theta axis", 1e-3, 1);
+  axis(o.cos_phi, "cos phi axis", -1, 1);
+  axis(o.spin_ratios, "spin ratio axis", 0, 1e6);
+  if (o.with_speed && !o.speeds.empty()) axis(o.speeds, "speed axis", 1e-3, 1e3);
+}
+
+ShapeModel build_model(const GatherOptions& o)
+{
+  if (o.box_size.empty()) return load_shape_model(o.shape, o.mesh_file, o.density);
+  ShapeModel m = make_box_model(Eigen::Vector3d(o.box_size[0], o.box_size[1], o.box_size[2]), o.density);
+  m.source = "generated " + num(o.box_size[0]) + " x " + num(o.box_size[1]) + " x " + num(o.box_size[2]) + " m box";
+  return m;
+}
+
+// ---- trials ----------------------------------------------------------------------------------
+
+double height_trial(const ShapeModel& m, double spin_ratio, std::uint64_t seed, std::uint64_t index)
+{
+  TrialRng rng(seed, kHeightStream, index);
+  const double L = m.bounding_radius, u = 1.0;
+  RigidState s;
+  s.orientation = rng.rotation();
+  s.spin = rng.direction() * (spin_ratio * u / L);
+  s.velocity = Eigen::Vector3d(0, 0, -u);
+  s.position = Eigen::Vector3d(0, 0, L * (1 + 1e-9));
+  const FreeFlight flight(m.unit_inertia);
+  const FirstContact fc = first_contact(m.hull, L, flight, s, 0.0, std::numeric_limits<double>::infinity(),
+                                        1e-12 * L, 100000000);
+  return fc.state.position.z() - lowest_point(m.hull, fc.state);
+}
+
+ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, double cos_theta, double cos_phi,
+                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index)
+{
+  const ShapeModel& m = ref.model();
+  TrialRng rng(o.seed, stream, index);
+  const double L = m.bounding_radius;
+  const double ct = cos_theta, st = std::sqrt(std::max(0.0, 1.0 - ct * ct));
+  const Eigen::Vector3d vhat(st, 0.0, -ct), e1(ct, 0.0, st), e2(0.0, 1.0, 0.0);
+  const double azimuth = 2.0 * kPi * rng.uniform();
+  const double alpha = ct >= 1.0 ? 0.0 : azimuth;
+  const double sp = std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi));
+  const Eigen::Vector3d wdir = cos_phi * vhat + sp * (std::cos(alpha) * e1 + std::sin(alpha) * e2);
+
+  RigidState s0;
+  s0.orientation = rng.rotation();
+  s0.velocity = speed * vhat;
+  s0.spin = wdir * (spin_ratio * speed / L);
+  s0.position = Eigen::Vector3d(0, 0, L * (1 + 1e-9));
+  const FreeFlight flight(m.unit_inertia);
+  const FirstContact fc = first_contact(m.hull, L, flight, s0, 0.0, std::numeric_limits<double>::infinity(),
+                                        1e-12 * L, 100000000);
+  RigidState start = fc.state;
+  start.position.z() -= 1e-6 * L;  // a hair into the ground, so that Bullet's first step has the contact
+  const ImpactResult ir = ref.impact(start, o.max_impact_time);
+
+  const Material mat{static_cast<Scalar>(o.reference.restitution), static_cast<Scalar>(o.reference.friction),
+                     static_cast<Scalar>(o.rolling_resistance)};
+  const Vector3 vminus = s0.velocity.cast<Scalar>();
+  const Vector3 vp = point_particle_velocity<3>(vminus, Vector3(0, 0, 1), mat,
+                                                static_cast<Scalar>(o.reference.restitution_threshold));
+  ResponseTrial out;
+  const Eigen::Vector3d w = ir.after.spin * (L / speed);
+  const Eigen::Vector3d dv = (ir.after.velocity - vp.cast<double>()) / speed;
+  out.value = {w.x(), w.y(), w.z(), dv.x(), dv.y(), dv.z()};
+  out.time_limited = ir.time_limited;
+  out.max_penetration = ir.max_penetration;
+  out.steps = ir.steps;
+  return out;
+}
+
+namespace {
+
+struct DropTrial {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  double height = 0.0;
+  double time = 0.0;
+  bool settled = false;
+};
+
+DropTrial drop_trial(const Reference& ref, const GatherOptions& o, std::uint64_t index)
+{
+  const ShapeModel& m = ref.model();
+  TrialRng rng(o.seed, kRestStream, index);
+  const double L = m.bounding_radius;
+  RigidState s;
+  s.orientation = rng.rotation();
+  s.velocity = Eigen::Vector3d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+  s.spin = rng.direction() * rng.uniform(0, 4 * kPi);
+  const double lift = L * rng.uniform(0.25, 3.0);
+  s.position = Eigen::Vector3d(0, 0, -lowest_point(m.hull, s) + lift);
+  const DropResult r = ref.drop(s, o.still_speed, o.still_time, o.max_drop_time);
+  DropTrial d;
+  d.up = r.rest.orientation.conjugate() * Eigen::Vector3d::UnitZ();
+  d.height = r.height;
+  d.time = r.time;
+  d.settled = r.settled;
+  return d;
+}
+
+// Clusters unit vectors: leader clustering in input order within `tol` (radians), then up to 20
+// rounds of assigning each vector to the nearest cluster mean (a new cluster when none is within
+// `tol`) until nothing moves. Returns the cluster of each vector; deterministic.
+std::vector<int> cluster_directions(const std::vector<Eigen::Vector3d>& dirs, double tol)
+{
+  const double cos_tol = std::cos(tol);
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<int> label(dirs.size(), -1);
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    int best = -1;
+    double best_c = cos_tol;
+    for (std::size_t c = 0; c < centres.size(); ++c) {
+      const double d = centres[c].dot(dirs[i]);
+      if (d >= best_c) {
+        best_c = d;
+        best = static_cast<int>(c);
+      }
+    }
+    if (best < 0) {
+      best = static_cast<int>(centres.size());
+      centres.push_back(dirs[i]);
+    }
+    label[i] = best;
+  }
+  for (int round = 0; round < 20; ++round) {
+    std::vector<Eigen::Vector3d> sum(centres.size(), Eigen::Vector3d::Zero());
+    for (std::size_t i = 0; i < dirs.size(); ++i) sum[label[i]] += dirs[i];
+    std::vector<Eigen::Vector3d> mean;
+    for (const auto& s : sum)
+      if (s.norm() > 0) mean.push_back(s.normalized());
+    bool moved = mean.size() != centres.size();
+    std::vector<int> next(dirs.size(), -1);
+    for (std::size_t i = 0; i < dirs.size(); ++i) {
+      int best = -1;
+      double best_c = cos_tol;
+      for (std::size_t c = 0; c < mean.size(); ++c) {
+        const double d = mean[c].dot(dirs[i]);
+        if (d >= best_c) {
+          best_c = d;
+          best = static_cast<int>(c);
+        }
+      }
+      if (best < 0) {
+        best = static_cast<int>(mean.size());
+        mean.push_back(dirs[i]);
+      }
+      next[i] = best;
+      moved = moved || next[i] != label[i];
+    }
+    label = next;
+    centres = mean;
+    if (!moved) break;
+  }
+  return label;
+}
+
+}  // namespace
+
+// ---- gathering -------------------------------------------------------------------------------
+
+GatherResult gather(const GatherOptions& options)
+{
+  validate_gather_options(options);
+  GatherResult r;
+  r.options = options;
+  GatherOptions& o = r.options;
+  r.model = build_model(o);
+  if (o.name.empty()) o.name = r.model.name;
+  if (!valid_identifier(o.name)) throw std::runtime_error("table name '" + o.name + "' is not a C++ identifier (use --name)");
+  if (o.with_speed && o.speeds.empty()) o.speeds = default_paper_speeds();
+  const ShapeModel& m = r.model;
+  const unsigned threads = o.threads;
+
+  // 1. h_coll.
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::size_t nr = o.height_ratios.size(), n = static_cast<std::size_t>(o.height_trials);
+    Progress progress("h_coll", nr * n, o.progress);
+    std::vector<double> h(nr * n);
+    const std::size_t chunk = 50;
+    const std::size_t tasks = (nr * n + chunk - 1) / chunk;
+    parallel_for(
+        tasks,
+        [&](std::size_t task) {
+          const std::size_t end = std::min(nr * n, (task + 1) * chunk);
+          for (std::size_t k = task * chunk; k < end; ++k) h[k] = height_trial(m, o.height_ratios[k / n], o.seed, k);
+          progress.add(end - task * chunk);
+        },
+        threads);
+    progress.finish();
+    for (std::size_t i = 0; i < nr; ++i) {
+      const Stats s = stats(n, [&](std::size_t k) { return h[i * n + k]; });
+      r.height_mean.push_back(s.mean);
+      r.height_std.push_back(s.std);
+    }
+    r.height_seconds = seconds_since(t0);
+  }
+
+  ReferencePool pool(m, o.reference);
+  {
+    Reference probe(m, o.reference);
+    r.ground = probe.ground() == Ground::box ? "box" : "plane";
+  }
+
+  // 2. Responses.
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<double> fixed_speed{o.speed};
+    const std::vector<double>& speeds = o.with_speed ? o.speeds : fixed_speed;
+    r.axes = {o.cos_theta, o.cos_phi};
+    if (o.with_speed) r.axes.push_back(o.speeds);
+    r.axes.push_back(o.spin_ratios);
+    const std::size_t nt = o.cos_theta.size(), np = o.cos_phi.size(), nv = speeds.size(), ns = o.spin_ratios.size();
+    const std::size_t cells = nt * np * nv * ns, trials = static_cast<std::size_t>(o.trials);
+    std::vector<ResponseTrial> all(cells * trials);
+    Progress progress("responses", cells * trials, o.progress);
+    parallel_for(
+        cells,
+        [&](std::size_t cell) {
+          const std::size_t is = cell % ns, iv = (cell / ns) % nv, ip = (cell / (ns * nv)) % np,
+                            it = cell / (ns * nv * np);
+          pool.with([&](const Reference& ref) {
+            for (std::size_t t = 0; t < trials; ++t)
+              all[cell * trials + t] = response_trial(ref, o, o.cos_theta[it], o.cos_phi[ip], speeds[iv],
+                                                      o.spin_ratios[is], kResponseStream, cell * trials + t);
+            return 0;
+          });
+          progress.add(trials);
+        },
+        threads);
+    progress.finish();
+    r.response_mean.assign(cells * 6, 0.0);
+    r.response_std.assign(cells * 6, 0.0);
+    for (std::size_t cell = 0; cell < cells; ++cell) {
+      const std::size_t is = cell % ns, iv = (cell / ns) % nv, it = cell / (ns * nv * np);
+      // At zero spin phi means nothing: pool the trials of every phi.
+      std::vector<const ResponseTrial*> pooled;
+      if (o.spin_ratios[is] == 0.0) {
+        for (std::size_t jp = 0; jp < np; ++jp) {
+          const std::size_t c2 = ((it * np + jp) * nv + iv) * ns + is;
+          for (std::size_t t = 0; t < trials; ++t) pooled.push_back(&all[c2 * trials + t]);
+        }
+      } else {
+        for (std::size_t t = 0; t < trials; ++t) pooled.push_back(&all[cell * trials + t]);
+      }
+      for (int c = 0; c < 6; ++c) {
+        const Stats s = stats(pooled.size(), [&](std::size_t k) { return pooled[k]->value[c]; });
+        r.response_mean[cell * 6 + c] = s.mean;
+        r.response_std[cell * 6 + c] = s.std;
+      }
+    }
+    for (const ResponseTrial& t : all) {
+      r.time_limited += t.time_limited ? 1 : 0;
+      r.max_penetration = std::max(r.max_penetration, t.max_penetration);
+    }
+    r.response_trials = static_cast<long long>(all.size());
+    r.response_seconds = seconds_since(t0);
+  }
+
+  // 3. Rest poses.
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::size_t n = static_cast<std::size_t>(o.rest_drops);
+    std::vector<DropTrial> drops(n);
+    Progress progress("rest drops", n, o.progress);
+    parallel_for(
+        n,
+        [&](std::size_t i) {
+          drops[i] = pool.with([&](const Reference& ref) { return drop_trial(ref, o, i); });
+          progress.add(1);
+        },
+        threads);
+    progress.finish();
+    std::vector<Eigen::Vector3d> ups;
+    std::vector<double> heights;
+    for (const DropTrial& d : drops) {
+      if (!d.settled) {
+        ++r.unsettled;
+        continue;
+      }
+      ++r.settled;
+      r.mean_settle_time += d.time;
+      ups.push_back(d.up);
+      heights.push_back(d.height);
+    }
+    if (r.settled > 0) r.mean_settle_time /= r.settled;
+    const std::vector<int> label = cluster_directions(ups, o.rest_tolerance_deg * kPi / 180.0);
+    int clusters = 0;
+    for (int l : label) clusters = std::max(clusters, l + 1);
+    std::vector<RestPose> poses;
+    for (int c = 0; c < clusters; ++c) {
+      std::vector<std::size_t> members;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (std::size_t i = 0; i < label.size(); ++i)
+        if (label[i] == c) {
+          members.push_back(i);
+          sum += ups[i];
+        }
+      if (members.empty()) continue;
+      RestPose p;
+      p.normal = sum.normalized();
+      // A body at rest stands on a face of its convex hull: snap to that face's normal.
+      double best = -2.0;
+      Eigen::Vector3d face = p.normal;
+      for (const Eigen::Vector4d& plane : m.hull_planes) {
+        const double along = -plane.head<3>().dot(p.normal);
+        if (along > best) {
+          best = along;
+          face = -plane.head<3>();
+        }
+      }
+      if (best >= std::cos(kSnapDegrees * kPi / 180.0)) {
+        p.normal = face + Eigen::Vector3d::Zero();  // + 0: no negative zeros
+        p.snapped = true;
+        // Standing on that face, the centre is exactly the face's offset above the ground.
+        for (const Eigen::Vector4d& plane : m.hull_planes)
+          if (-plane.head<3>() == face) p.height = plane.w();
+      }
+      const Stats s = stats(members.size(), [&](std::size_t k) { return heights[members[k]]; });
+      p.height = s.mean;
+      p.measured_height = s.mean;
+      p.height_std = s.std;
+      p.count = static_cast<int>(members.size());
+      p.frequency = static_cast<double>(p.count) / static_cast<double>(std::max(1, r.settled));
+      poses.push_back(p);
+    }
+    std::stable_sort(poses.begin(), poses.end(), [](const RestPose& a, const RestPose& b) {
+      if (a.count != b.count) return a.count > b.count;
+      for (int k = 0; k < 3; ++k)
+        if (a.normal[k] != b.normal[k]) return a.normal[k] < b.normal[k];
+      return false;
+    });
+    for (const RestPose& p : poses) (p.frequency > o.rest_min_frequency ? r.rest : r.rest_rare).push_back(p);
+    r.rest_seconds = seconds_since(t0);
+  }
+  return r;
+}
+
+// ---- output ----------------------------------------------------------------------------------
+
+Quantized quantize(const std::vector<float>& values)
+{
+  Quantized out;
+  if (values.empty()) return out;
+  float lo = values[0], hi = values[0];
+  for (float v : values) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  out.offset = 0.5f * (lo + hi);
+  out.scale = hi > lo ? (hi - lo) / 65534.0f : 1.0f;
+  out.q.reserve(values.size());
+  for (float v : values) {
+    const double qd = std::nearbyint((static_cast<double>(v) - out.offset) / out.scale);
+    const auto q = static_cast<std::int16_t>(std::clamp(qd, -32767.0, 32767.0));
+    out.q.push_back(q);
+    // As the runtime dequantises: offset + scale * Scalar(q), in float.
+    const float back = out.offset + out.scale * static_cast<float>(q);
+    out.worst_error = std::max(out.worst_error, std::fabs(static_cast<double>(back) - static_cast<double>(v)));
+  }
+  return out;
+}
+
+namespace {
+
+std::string hexf(float x)
+{
+  if (x == 0.0f) return "0x0p+0f";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%af", static_cast<double>(x));
+  return buf;
+}
+
+std::vector<float> to_float(const std::vector<double>& v)
+{
+  std::vector<float> f;
+  f.reserve(v.size());
+  for (double x : v) f.push_back(static_cast<float>(x) + 0.0f);
+  return f;
+}
+
+// "{{a, b, c}}" with `per_line` values per line, indented.
+std::string float_array(const std::vector<float>& v, std::size_t per_line)
+{
+  if (v.empty()) return "{}";
+  std::string s = "{{";
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v.size() > per_line && i % per_line == 0) s += "\n      ";
+    s += hexf(v[i]);
+    if (i + 1 < v.size()) s += (v.size() > per_line && (i + 1) % per_line == 0) ? "," : ", ";
+  }
+  s += v.size() > per_line ? "\n    }}" : "}}";
+  return s;
+}
+
+std::string int_array(const std::vector<std::int16_t>& v, std::size_t per_line)
+{
+  if (v.empty()) return "{}";
+  std::string s = "{{";
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (i % per_line == 0) s += "\n      ";
+    s += std::to_string(v[i]);
+    if (i + 1 < v.size()) s += (i + 1) % per_line == 0 ? "," : ", ";
+  }
+  s += "\n    }}";
+  return s;
+}
+
+std::string hex64(std::uint64_t x)
+{
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(x));
+  return buf;
+}
+
+std::string vec3(const Eigen::Vector3d& v, const char* f = "%.6g")
+{
+  return "(" + fmt(f, v.x()) + ", " + fmt(f, v.y()) + ", " + fmt(f, v.z()) + ")";
+}
+
+std::string shape_description(const GatherResult& r)
+{
+  const ShapeModel& m = r.model;
+  const double margin = r.options.reference.margin;
+  std::string s;
+  switch (m.kind) {
+    case ShapeKind::box: {
+      const BodyBox& b = m.boxes.at(0);
+      s = "btBoxShape, half extents " + vec3(b.rotation.cwiseAbs() * b.half_extents) + " m";
+      break;
+    }
+    case ShapeKind::compound:
+      s = "btCompoundShape of " + std::to_string(m.boxes.size()) + " btBoxShapes (tools/mesh/shapes.hpp)";
+      break;
+    case ShapeKind::mesh:
+      s = "btGImpactMeshShape of the full mesh (" + std::to_string(m.body_mesh.vertices.size()) + " vertices, " +
+          std::to_string(m.body_mesh.triangles.size()) + " triangles)";
+      break;
+  }
+  return s + ", margin " + num(margin) + " m; ground: " +
+         (r.ground == "box" ? "a static btBoxShape (top face z = 0)" : "btStaticPlaneShape z = 0");
+}
+
+std::vector<std::string> option_lines(const GatherResult& r)
+{
+  const GatherOptions& o = r.options;
+  const ReferenceSettings& s = o.reference;
+  std::vector<std::string> l;
+  l.push_back("layout " + std::string(o.with_speed ? "with_speed (cos theta, cos phi, |V-|, spin ratio)"
+                                                     : "scaled (cos theta, cos phi, spin ratio)") +
+              (o.with_speed ? "" : ", impacts at |V-| = " + num(o.speed) + " m/s") + "; precision " +
+              (o.i16 ? "i16" : "f32") + "; seed " + std::to_string(o.seed));
+  l.push_back("restitution " + num(s.restitution) + ", friction " + num(s.friction) + ", restitution threshold " +
+              num(s.restitution_threshold) + " m/s, rolling resistance (runtime only) " + num(o.rolling_resistance));
+  l.push_back("dt " + num(s.dt) + " s, " + std::to_string(s.solver_iterations) + " solver iterations, warm starting " +
+              (s.warm_starting ? "on" : "off") + ", split impulse " + (s.split_impulse ? "always" : "Bullet's default") +
+              ", erp " + num(s.erp) + ", speculative contacts " + (s.speculative_contacts ? "on" : "off") +
+              ", density " + num(o.density) + " kg/m^3");
+  l.push_back("h_coll: " + std::to_string(o.height_trials) + " flights per ratio; responses: " +
+              std::to_string(o.trials) + " impacts per cell (phi pooled at zero spin), time limit " +
+              num(o.max_impact_time) + " s; rest: " + std::to_string(o.rest_drops) + " drops, still below " +
+              num(o.still_speed) + " m/s for " + num(o.still_time) + " s (limit " + num(o.max_drop_time) +
+              " s), clusters within " + num(o.rest_tolerance_deg) + " deg, kept above " +
+              num(o.rest_min_frequency));
+  return l;
+}
+
+}  // namespace
+
+std::string header_text(const GatherResult& r, const std::string& command)
+{
+  const GatherOptions& o = r.options;
+  const ShapeModel& m = r.model;
+  std::ostringstream h;
+  h << "// generated by statsim gather \u2014 do not edit\n";
+  h << "// command: " << command << "\n";
+  h << "// (run from the repository root; tools/regenerate-tables.sh regenerates every table and diffs it)\n";
+  for (const std::string& line : option_lines(r)) h << "// Options: " << line << "\n";
+  h << "// Input: " << m.source;
+  if (m.source_hash != 0) h << " (FNV-1a 64 " << hex64(m.source_hash) << ")";
+  h << ", " << m.body_mesh.vertices.size() << " vertices, " << m.body_mesh.triangles.size() << " triangles\n";
+  h << "// Reference: Bullet " << bullet_version() << " (double precision); " << shape_description(r) << "\n";
+  h << "// Mass properties: volume " << fmt("%.9g", m.mass.volume) << " m^3, mass " << fmt("%.9g", m.mass.mass)
+    << " kg, principal moments " << vec3(m.mass.principal_moments, "%.9g") << " kg m^2, bounding radius "
+    << fmt("%.9g", m.bounding_radius) << " m (= L of the spin ratios)\n";
+  h << "// Trials: " << r.height_mean.size() * static_cast<std::size_t>(o.height_trials) << " flights, "
+    << r.response_trials << " impacts (" << r.time_limited << " hit the time limit), " << o.rest_drops
+    << " rest drops (" << r.unsettled << " did not settle)\n";
+  h << "// Rest poses (body-frame up, height, frequency):";
+  for (const RestPose& p : r.rest) h << " " << vec3(p.normal, "%.4f") << " " << fmt("%.5f", p.height) << " m " << fmt("%.3f", p.frequency) << ";";
+  h << "\n";
+  if (o.i16) {
+    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
+    h << "// i16 dequantization error: mean table " << fmt("%.3g", qm.worst_error) << ", std table "
+      << fmt("%.3g", qs.worst_error) << " (worst " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << ")\n";
+  }
+  h << "#pragma once\n\n#include \"statsim/signature.hpp\"\n\n";
+  h << "static_assert(STATSIM_TABLE_FORMAT_VERSION == 1, \"tables/" << o.name
+    << ".hpp was generated for table format 1: regenerate it with the command above\");\n\n";
+  const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
+                    a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
+  h << "namespace statsim::tables {\n\n";
+  h << "inline constexpr " << (o.i16 ? "SignatureQ16" : "Signature") << "<3, " << r.height_mean.size() << ", "
+    << a0 << ", " << a1 << ", " << a2 << ", " << a3 << ", " << r.rest.size() << "> " << o.name << " = {\n";
+  h << "    \"" << o.name << "\",\n";
+  h << "    " << hexf(static_cast<float>(m.bounding_radius)) << ",  // length L, m\n";
+  h << "    " << hexf(static_cast<float>(m.bounding_radius)) << ",  // bounding radius, m\n";
+  h << "    " << hexf(static_cast<float>(m.mass.mass)) << ",  // mass, kg\n";
+  h << "    " << float_array(to_float({m.unit_inertia.x(), m.unit_inertia.y(), m.unit_inertia.z()}), 8)
+    << ",  // principal moments / mass, m^2\n";
+  h << "    {" << hexf(static_cast<float>(o.reference.restitution)) << ", " << hexf(static_cast<float>(o.reference.friction))
+    << ", " << hexf(static_cast<float>(o.rolling_resistance)) << "},  // material\n";
+  h << "    " << hexf(static_cast<float>(o.reference.restitution_threshold)) << ",  // restitution threshold, m/s\n";
+  h << "    statsim::ResponseLayout::" << (o.with_speed ? "with_speed" : "scaled") << ",\n";
+  h << "    " << r.axes.size() << "u,  // response axes\n";
+  h << "    // h_coll: spin ratio, mean, std (m)\n";
+  h << "    " << float_array(to_float(o.height_ratios), 8) << ",\n";
+  h << "    " << float_array(to_float(r.height_mean), 8) << ",\n";
+  h << "    " << float_array(to_float(r.height_std), 8) << ",\n";
+  h << "    // response axes: cos theta, cos phi, " << (o.with_speed ? "speed (m/s), " : "") << "spin ratio"
+    << (o.with_speed ? "" : ", (unused)") << "\n";
+  for (std::size_t a = 0; a < 4; ++a)
+    h << "    " << (a < r.axes.size() ? float_array(to_float(r.axes[a]), 8) : std::string("{{0x0p+0f}}")) << ",\n";
+  h << "    // response mean, then std, per cell: w_x, w_y, w_z (W+ L/|V-|), dv_x, dv_y, dv_z ((V+ - V_particle+)/|V-|)\n";
+  if (o.i16) {
+    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
+    h << "    " << hexf(qm.scale) << ", " << hexf(qm.offset) << ",  // mean scale, offset\n";
+    h << "    " << int_array(qm.q, 6) << ",\n";
+    h << "    " << hexf(qs.scale) << ", " << hexf(qs.offset) << ",  // std scale, offset\n";
+    h << "    " << int_array(qs.q, 6) << ",\n";
+  } else {
+    h << "    " << float_array(to_float(r.response_mean), 6) << ",\n";
+    h << "    " << float_array(to_float(r.response_std), 6) << ",\n";
+  }
+  std::vector<double> normals, heights, freqs;
+  for (const RestPose& p : r.rest) {
+    normals.insert(normals.end(), {p.normal.x(), p.normal.y(), p.normal.z()});
+    heights.push_back(p.height);
+    freqs.push_back(p.frequency);
+  }
+  h << "    // rest poses: body-frame up vectors, centre heights (m), frequencies\n";
+  h << "    " << float_array(to_float(normals), 3) << ",\n";
+  h << "    " << float_array(to_float(heights), 8) << ",\n";
+  h << "    " << float_array(to_float(freqs), 8) << ",\n";
+  h << "};\n\n}  // namespace statsim::tables\n";
+  return h.str();
+}
+
+std::string json_text(const GatherResult& r, const std::string& command)
+{
+  using json = nlohmann::ordered_json;
+  const GatherOptions& o = r.options;
+  const ShapeModel& m = r.model;
+  auto fl = [](const std::vector<double>& v) {
+    json a = json::array();
+    for (double x : v) a.push_back(static_cast<double>(static_cast<float>(x)) + 0.0);
+    return a;
+  };
+  json j;
+  j["generator"] = "statsim gather";
+  j["command"] = command;
+  j["name"] = o.name;
+  j["source"] = m.source;
+  j["source_fnv1a64"] = hex64(m.source_hash);
+  j["bullet"] = bullet_version();
+  j["seed"] = o.seed;
+  j["reference"] = {{"shape", shape_description(r)},
+                    {"restitution", o.reference.restitution},
+                    {"friction", o.reference.friction},
+                    {"restitution_threshold", o.reference.restitution_threshold},
+                    {"dt", o.reference.dt},
+                    {"solver_iterations", o.reference.solver_iterations},
+                    {"warm_starting", o.reference.warm_starting},
+                    {"split_impulse", o.reference.split_impulse},
+                    {"erp", o.reference.erp},
+                    {"speculative_contacts", o.reference.speculative_contacts},
+                    {"margin", o.reference.margin},
+                    {"ground", r.ground}};
+  j["density"] = o.density;
+  j["volume"] = m.mass.volume;
+  j["mass"] = static_cast<double>(static_cast<float>(m.mass.mass));
+  j["inertia"] = {m.mass.principal_moments.x(), m.mass.principal_moments.y(), m.mass.principal_moments.z()};
+  j["unit_inertia"] = fl({m.unit_inertia.x(), m.unit_inertia.y(), m.unit_inertia.z()});
+  j["bounding_radius"] = static_cast<double>(static_cast<float>(m.bounding_radius));
+  j["length"] = static_cast<double>(static_cast<float>(m.bounding_radius));
+  j["material"] = {{"restitution", static_cast<double>(static_cast<float>(o.reference.restitution))},
+                   {"friction", static_cast<double>(static_cast<float>(o.reference.friction))},
+                   {"rolling_resistance", static_cast<double>(static_cast<float>(o.rolling_resistance))}};
+  j["restitution_threshold"] = static_cast<double>(static_cast<float>(o.reference.restitution_threshold));
+  j["h_coll"] = {{"ratio", fl(o.height_ratios)},
+                 {"mean", fl(r.height_mean)},
+                 {"std", fl(r.height_std)},
+                 {"trials", o.height_trials}};
+  json axes = json::array();
+  const char* names4[] = {"cos_theta", "cos_phi", "speed", "spin_ratio"};
+  const char* names3[] = {"cos_theta", "cos_phi", "spin_ratio"};
+  for (std::size_t a = 0; a < r.axes.size(); ++a)
+    axes.push_back({{"name", r.axes.size() == 4 ? names4[a] : names3[a]}, {"values", fl(r.axes[a])}});
+  json resp = {{"layout", o.with_speed ? "with_speed" : "scaled"},
+               {"speed", o.with_speed ? json(nullptr) : json(o.speed)},
+               {"axes", axes},
+               {"components", {"w_x", "w_y", "w_z", "dv_x", "dv_y", "dv_z"}},
+               {"mean", fl(r.response_mean)},
+               {"std", fl(r.response_std)},
+               {"trials_per_cell", o.trials},
+               {"trials", r.response_trials},
+               {"time_limited", r.time_limited},
+               {"max_penetration", r.max_penetration}};
+  if (o.i16) {
+    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
+    resp["i16"] = {{"mean_scale", static_cast<double>(qm.scale)},
+                   {"mean_offset", static_cast<double>(qm.offset)},
+                   {"std_scale", static_cast<double>(qs.scale)},
+                   {"std_offset", static_cast<double>(qs.offset)},
+                   {"worst_error", std::max(qm.worst_error, qs.worst_error)}};
+  }
+  j["response"] = resp;
+  json rest = json::array();
+  for (const RestPose& p : r.rest)
+    rest.push_back({{"normal", fl({p.normal.x(), p.normal.y(), p.normal.z()})},
+                    {"height", static_cast<double>(static_cast<float>(p.height))},
+                    {"frequency", static_cast<double>(static_cast<float>(p.frequency))},
+                    {"measured_height", p.measured_height},
+                    {"height_std", p.height_std},
+                    {"snapped", p.snapped},
+                    {"count", p.count}});
+  j["rest"] = rest;
+  json rare = json::array();
+  for (const RestPose& p : r.rest_rare)
+    rare.push_back({{"normal", {p.normal.x(), p.normal.y(), p.normal.z()}},
+                    {"height", p.height},
+                    {"frequency", p.frequency},
+                    {"count", p.count}});
+  j["rest_rare"] = rare;
+  j["rest_drops"] = o.rest_drops;
+  j["settled"] = r.settled;
+  j["unsettled"] = r.unsettled;
+  return j.dump(2) + "\n";
+}
+
+std::string summary_text(const GatherResult& r)
+{
+  std::ostringstream s;
+  const ShapeModel& m = r.model;
+  s << "shape " << r.options.name << ": mass " << fmt("%.6g", m.mass.mass) << " kg, bounding radius "
+    << fmt("%.6g", m.bounding_radius) << " m, unit inertia " << vec3(m.unit_inertia) << " m^2\n";
+  s << "h_coll: " << fmt("%.5f", r.height_mean.front()) << " m at s = " << num(r.options.height_ratios.front()) << " to "
+    << fmt("%.5f", r.height_mean.back()) << " m at s = " << num(r.options.height_ratios.back()) << " ("
+    << fmt("%.1f", r.height_seconds) << " s)\n";
+  s << "responses: " << r.response_trials << " impacts, " << r.time_limited << " time-limited, deepest penetration "
+    << fmt("%.3g", r.max_penetration) << " m (" << fmt("%.1f", r.response_seconds) << " s)\n";
+  s << "rest: " << r.settled << " settled (mean " << fmt("%.2f", r.mean_settle_time) << " s), " << r.unsettled << " unsettled; " << r.rest.size() << " poses kept, "
+    << r.rest_rare.size() << " rare (" << fmt("%.1f", r.rest_seconds) << " s)\n";
+  for (const RestPose& p : r.rest)
+    s << "  up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m (std " << fmt("%.2g", p.height_std)
+      << ")  frequency " << fmt("%.3f", p.frequency) << "\n";
+  for (const RestPose& p : r.rest_rare)
+    s << "  (rare) up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m  frequency "
+      << fmt("%.3f", p.frequency) << "\n";
+  if (r.options.i16) {
+    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
+    s << "i16: worst dequantization error " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << "\n";
+  }
+  return s.str();
+}
+
+// ---- checks ----------------------------------------------------------------------------------
+
+namespace {
+
+struct CheckCell {
+  double cos_theta, cos_phi, spin_ratio;
+};
+
+}  // namespace
+
+std::string speed_check_report(const GatherOptions& options, const std::vector<double>& speeds, int trials)
+{
+  GatherOptions o = options;
+  validate_gather_options(o);
+  const ShapeModel m = build_model(o);
+  ReferencePool pool(m, o.reference);
+  const std::vector<CheckCell> cells = {{1.0, 0.0, 0.0}, {1.0, 0.0, 0.5}, {0.7, 0.0, 0.0},  {0.7, 0.5, 1.0},
+                                        {0.4, 0.0, 0.3}, {0.4, -0.5, 2.0}, {0.1, 0.0, 0.0}, {0.1, 0.5, 1.0}};
+  const std::size_t nc = cells.size(), nv = speeds.size(), n = static_cast<std::size_t>(trials);
+  std::vector<ResponseTrial> all(nc * nv * n);
+  Progress progress("speed check", nc * nv * n, o.progress);
+  parallel_for(
+      nc * nv,
+      [&](std::size_t task) {
+        const std::size_t c = task / nv, v = task % nv;
+        pool.with([&](const Reference& ref) {
+          // The same orientations at every speed (index independent of the speed): paired samples.
+          for (std::size_t t = 0; t < n; ++t)
+            all[task * n + t] = response_trial(ref, o, cells[c].cos_theta, cells[c].cos_phi, speeds[v],
+                                               cells[c].spin_ratio, kCheckStream, c * n + t);
+          return 0;
+        });
+        progress.add(n);
+      },
+      o.threads);
+  progress.finish();
+  std::ostringstream s;
+  s << "Speed invariance of the reference (" << m.name << ", " << trials
+    << " impacts per cell and speed, the same orientations at every speed): normalised means\n";
+  s << "(W+ L/|V-| and (V+ - V_particle+)/|V-|; restitution " << num(o.reference.restitution) << ", friction "
+    << num(o.reference.friction) << ", threshold " << num(o.reference.restitution_threshold) << " m/s, dt "
+    << num(o.reference.dt) << " s). Last column: the largest standard error of the means in the row.\n\n";
+  s << "| cos theta | cos phi | s | quantity |";
+  for (double v : speeds) s << " " << num(v) << " m/s |";
+  s << " s.e. |\n|---|---|---|---|";
+  for (std::size_t v = 0; v < nv; ++v) s << "---|";
+  s << "---|\n";
+  const char* names[] = {"w_x", "w_y", "w_z", "dv_x", "dv_y", "dv_z"};
+  int time_limited = 0;
+  for (const ResponseTrial& t : all) time_limited += t.time_limited ? 1 : 0;
+  for (std::size_t c = 0; c < nc; ++c) {
+    for (int comp : {1, 3, 5, 6}) {
+      s << "| " << num(cells[c].cos_theta) << " | " << num(cells[c].cos_phi) << " | " << num(cells[c].spin_ratio) << " | "
+        << (comp == 6 ? "|W+| L/|V-|" : names[comp]) << " |";
+      double se = 0.0;
+      for (std::size_t v = 0; v < nv; ++v) {
+        const ResponseTrial* base = &all[(c * nv + v) * n];
+        const Stats st = stats(n, [&](std::size_t k) {
+          const Response& x = base[k].value;
+          return comp == 6 ? std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) : x[comp];
+        });
+        se = std::max(se, st.std / std::sqrt(static_cast<double>(n)));
+        s << " " << fmt("%+.3f", st.mean) << " |";
+      }
+      s << " " << fmt("%.3f", se) << " |\n";
+    }
+  }
+  s << "\n" << time_limited << " of " << all.size() << " impacts hit the time limit.\n";
+  return s.str();
+}
+
+std::string step_check_report(const GatherOptions& options)
+{
+  GatherOptions base = options;
+  base.cos_theta = {0.25, 0.7, 1.0};
+  base.cos_phi = {-1.0, 0.0, 1.0};
+  base.spin_ratios = {0.0, 1.0, 4.0, 8.0};
+  base.height_ratios = {0.0};
+  base.height_trials = 2;
+  base.with_speed = false;
+  const double dt = options.reference.dt;
+  std::vector<double> steps;
+  for (double d : {1.0 / 60.0, 1.0 / 240.0})
+    if (d > 1.5 * dt) steps.push_back(d);
+  steps.push_back(dt);
+  steps.push_back(dt / 2);
+  std::vector<GatherResult> runs;
+  for (double d : steps) {
+    GatherOptions o = base;
+    o.reference.dt = d;
+    runs.push_back(gather(o));
+  }
+  const GatherResult& fine = runs.back();
+  std::ostringstream s;
+  s << "Time step (" << fine.model.name << "): a small gathering at each dt, the same random trials: "
+    << fine.response_mean.size() / 6 << " response cells (cos theta 0.25, 0.7, 1; cos phi -1, 0, 1; s 0, 1, 4, 8) x "
+    << options.trials << " impacts at " << num(options.speed) << " m/s, and " << options.rest_drops
+    << " rest drops. Response change: the largest |difference| of a normalised mean from the dt = " << num(steps.back())
+    << " s run, and that difference over its standard error (unpaired). h_coll does not depend on dt (exact free flight).\n\n";
+  s << "| dt (s) | drops settled | mean time to settle (s) | impacts time-limited | largest response change | in standard errors |\n";
+  s << "|---|---|---|---|---|---|\n";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const GatherResult& a = runs[k];
+    double worst = 0.0, worst_z = 0.0;
+    for (std::size_t i = 0; i < a.response_mean.size(); ++i) {
+      const double d = std::fabs(a.response_mean[i] - fine.response_mean[i]);
+      const double se = std::sqrt((a.response_std[i] * a.response_std[i] + fine.response_std[i] * fine.response_std[i]) /
+                                  static_cast<double>(options.trials));
+      worst = std::max(worst, d);
+      if (se > 0) worst_z = std::max(worst_z, d / se);
+    }
+    s << "| " << num(steps[k]) << " | " << a.settled << " / " << (a.settled + a.unsettled) << " | "
+      << fmt("%.2f", a.mean_settle_time) << " | " << a.time_limited << " | "
+      << (k + 1 == runs.size() ? std::string("-") : fmt("%.4f", worst)) << " | "
+      << (k + 1 == runs.size() ? std::string("-") : fmt("%.2f", worst_z)) << " |\n";
+  }
+  // Rest poses: those of the finest run, with their frequency at every dt (matched by normal).
+  std::vector<RestPose> poses = fine.rest;
+  poses.insert(poses.end(), fine.rest_rare.begin(), fine.rest_rare.end());
+  s << "\n| rest pose (body-frame up) | h_rest (m) |";
+  for (double d : steps) s << " frequency at dt " << num(d) << " |";
+  s << "\n|---|---|";
+  for (std::size_t k = 0; k < steps.size(); ++k) s << "---|";
+  s << "\n";
+  const double cos_tol = std::cos(options.rest_tolerance_deg * kPi / 180.0);
+  for (const RestPose& p : poses) {
+    s << "| " << vec3(p.normal, "%.3f") << " | " << fmt("%.4f", p.height) << " |";
+    for (const GatherResult& a : runs) {
+      double f = 0.0;
+      for (const auto* list : {&a.rest, &a.rest_rare})
+        for (const RestPose& q : *list)
+          if (q.normal.dot(p.normal) >= cos_tol) f += q.frequency;
+      s << " " << fmt("%.3f", f) << " |";
+    }
+    s << "\n";
+  }
+  return s.str();
+}
+
+std::string settings_check_report(const GatherOptions& options)
+{
+  // A face-down cube (the committed box) at normal incidence: it should leave at e |V-| with no
+  // spin. Bullet's defaults vs the reference's settings, one fix at a time.
+  const ShapeModel box = load_shape_model("box", "", options.density);
+  struct Row {
+    std::string name;
+    ReferenceSettings s;
+    bool start_gap;  // start a random fraction of a step above the ground (as a drop would)
+  };
+  ReferenceSettings defaults;
+  defaults.dt = 1.0 / 60;
+  defaults.solver_iterations = 10;
+  defaults.warm_starting = true;
+  defaults.split_impulse = false;
+  defaults.margin = 0.04;
+  defaults.ground_auto = false;
+  defaults.ground = Ground::plane;
+  defaults.multipoint_plane = false;
+  defaults.speculative_contacts = true;
+  defaults.restitution = options.reference.restitution;
+  defaults.friction = options.reference.friction;
+  defaults.restitution_threshold = 0.2;
+  std::vector<Row> rows;
+  rows.push_back({"Bullet defaults (dt 1/60, plane: one new contact point per step, margin 0.04, split impulse only "
+                  "below 4 cm of penetration, warm starting, 10 iterations, speculative contacts)",
+                  defaults, true});
+  ReferenceSettings s1 = defaults;
+  s1.split_impulse = true;
+  s1.warm_starting = false;
+  s1.solver_iterations = options.reference.solver_iterations;
+  rows.push_back({"+ split impulse always, no warm starting, " + std::to_string(s1.solver_iterations) + " iterations",
+                  s1, true});
+  ReferenceSettings s2 = s1;
+  s2.multipoint_plane = true;
+  rows.push_back({"+ plane manifold of 4 points (setPlaneConvexMultipointIterations)", s2, true});
+  ReferenceSettings s3 = s2;
+  s3.speculative_contacts = false;
+  rows.push_back({"+ no speculative contacts (contact processing threshold 0)", s3, true});
+  ReferenceSettings s4 = s3;
+  s4.dt = options.reference.dt;
+  s4.margin = options.reference.margin;
+  rows.push_back({"+ dt " + num(s4.dt) + " s, margin " + num(s4.margin) + " m", s4, true});
+  ReferenceSettings s5 = s4;
+  s5.ground_auto = true;
+  rows.push_back({"+ box ground (btBoxBoxDetector: the whole contact face at once)", s5, true});
+  ReferenceSettings s6 = s5;
+  s6.restitution_threshold = options.reference.restitution_threshold;
+  rows.push_back({"+ restitution threshold " + num(s6.restitution_threshold) + " m/s (Bullet: 0.2)", s6, true});
+  rows.push_back({"reference settings, each impact starting at its exact first contact", options.reference, false});
+  const std::vector<double> speeds = {0.25, 0.5, 1, 2, 4, 8};
+  const std::vector<double> random_speeds = {0.5, 2, 8};
+  std::ostringstream s;
+  s << "Face-down cube (" << box.source << "), normal incidence, no gravity: rebound V+_z / |V-| and spin |W+| L / |V-|"
+    << " (restitution " << num(options.reference.restitution) << "); the last columns: the mean V+_z/|V-| over 200"
+    << " random orientations (the same at every speed) at normal incidence.\n\n| settings |";
+  for (double v : speeds) s << " " << num(v) << " m/s |";
+  for (double v : random_speeds) s << " random, " << num(v) << " m/s |";
+  s << "\n|---|";
+  for (std::size_t i = 0; i < speeds.size() + random_speeds.size(); ++i) s << "---|";
+  s << "\n";
+  for (const Row& row : rows) {
+    Reference ref(box, row.s);
+    s << "| " << row.name << " |";
+    for (double u : speeds) {
+      RigidState st;
+      st.velocity = Eigen::Vector3d(0, 0, -u);
+      const double gap = row.start_gap ? 0.5 * u * row.s.dt : -1e-7;
+      st.position = Eigen::Vector3d(0, 0, 0.1 + gap);
+      const ImpactResult ir = ref.impact(st, 2.0);
+      s << " " << fmt("%.3f", ir.after.velocity.z() / u) << " / " << fmt("%.3f", ir.after.spin.norm() * box.bounding_radius / u)
+        << " |";
+    }
+    for (double u : random_speeds) {
+      double mean = 0.0;
+      const int n = 200;
+      for (int k = 0; k < n; ++k) {
+        TrialRng rng(options.seed, kCheckStream + 1, static_cast<std::uint64_t>(k));
+        RigidState st;
+        st.orientation = rng.rotation();
+        st.velocity = Eigen::Vector3d(0, 0, -u);
+        const double gap = row.start_gap ? u * row.s.dt * rng.uniform() : -1e-7;
+        st.position = Eigen::Vector3d(0, 0, -lowest_point(box.hull, st) + gap);
+        mean += ref.impact(st, 2.0).after.velocity.z() / u;
+      }
+      s << " " << fmt("%.3f", mean / n) << " |";
+    }
+    s << "\n";
+  }
+  return s.str();
+}
+
+}  // namespace statsim::tools::ref3d

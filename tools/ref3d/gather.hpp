@@ -1,0 +1,153 @@
+// `statsim gather`: a shape's statistical signature (paper 3.2) measured with the 3D reference,
+// and its C++ table (tables/NAME.hpp) and JSON dump.
+//
+// What is measured (all in the canonical frame of paper Figure 4a: normal +z, V- in the xz plane
+// with a non-negative x component; statsim/signature.hpp and statsim/statistical.hpp read it):
+// 1. h_coll: the centre-of-mass height above the plane at the first contact of the true geometry,
+//    from the exact torque-free flight (no stepping): straight down at |v|, uniform random
+//    orientation, uniform random spin axis, |w| = s |v| / L, L the bounding radius; the flight
+//    starts with the centre at L above the plane (uniform orientation there makes the contact
+//    phase uniform). Mean and sample standard deviation per spin-ratio sample s.
+// 2. Responses: per cell (cos theta, cos phi, [|V-|,] s), `trials` impacts in Bullet without
+//    gravity, each from a uniform random orientation at the exact first contact of its free
+//    flight (V- = |V-| (sin theta, 0, -cos theta); W- at angle phi to V-, at a uniform random
+//    azimuth about V-, except at cos theta = 1 where the azimuth is the one the runtime's frame
+//    takes (W-'s tangential part along +x)), until the body leaves the ground for good.
+//    Per cell: mean and std of W+ L / |V-| and (V_rigid+ - V_particle+) / |V-|, V_particle+ from
+//    statsim::point_particle_velocity. At s = 0 phi does not matter, and the cells of all phi
+//    share the statistics of all their trials.
+// 3. Rest poses: `rest_drops` drops with gravity from random poses and velocities until the body
+//    is still; body-frame up vectors clustered within `rest_tolerance_deg`; clusters with more
+//    than `rest_min_frequency` of the settled drops are kept, with their mean centre height on
+//    the true geometry and their frequency. A body at rest stands on a face of its convex hull, so
+//    a cluster's mean normal within 3 degrees of a hull face's is replaced by the face's, and its
+//    height by the face's distance from the centre of mass (the measured mean is in the JSON).
+#pragma once
+
+#include "ref3d/model.hpp"
+#include "ref3d/reference.hpp"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace statsim::tools::ref3d {
+
+/// Default axes.
+std::vector<double> default_height_ratios();   ///< 16 spin ratios, dense near zero, 0 .. 64
+std::vector<double> default_cos_theta();       ///< 7: 0.1 .. 1
+std::vector<double> default_cos_phi();         ///< 10: -1 .. 1
+std::vector<double> default_spin_ratios();     ///< 16: 0 .. 8
+std::vector<double> default_paper_speeds();    ///< 26 speeds for --layout paper, m/s
+std::vector<double> default_coarse_speeds();   ///< the coarse speed axis, m/s
+
+struct GatherOptions {
+  std::string shape = "box";  ///< box, lshape, bunny (ignored when mesh_file is set)
+  std::string mesh_file;      ///< any closed OBJ (btGImpactMeshShape)
+  std::vector<double> box_size;  ///< non-empty: a generated box of this size (m), btBoxShape
+  std::string name;           ///< table name (a C++ identifier)
+  bool with_speed = false;    ///< response layout: false = scaled (cos theta, cos phi, s), true = with speed
+  int trials = 30;            ///< impacts per response cell
+  int height_trials = 1000;   ///< flights per h_coll sample
+  int rest_drops = 1000;
+  std::uint64_t seed = 1;
+  bool i16 = false;           ///< --precision i16
+  unsigned threads = 0;       ///< 0 = all hardware threads
+  bool progress = false;      ///< progress and ETA on stderr
+  double density = 1000.0;    ///< kg/m^3
+  double speed = 2.0;         ///< |V-| of the scaled layout's impacts, m/s
+  double rolling_resistance = 0.05;  ///< written to the signature's material (the runtime's spheres)
+  double max_impact_time = 2.0;      ///< s of an impact before it counts as time-limited
+  double still_speed = 0.005;        ///< m/s: average speeds (centre, farthest point) below this are still
+  double still_time = 0.25;          ///< s: a drop has settled after two still windows of this length
+  double max_drop_time = 60.0;       ///< s before a drop counts as unsettled
+  double rest_tolerance_deg = 10.0;
+  double rest_min_frequency = 0.05;
+  std::vector<double> height_ratios = default_height_ratios();
+  std::vector<double> cos_theta = default_cos_theta();
+  std::vector<double> cos_phi = default_cos_phi();
+  std::vector<double> spin_ratios = default_spin_ratios();
+  std::vector<double> speeds;  ///< empty: default_paper_speeds() when with_speed
+  ReferenceSettings reference;
+};
+
+/// Checks the options; throws std::runtime_error naming the first problem.
+void validate_gather_options(const GatherOptions& o);
+
+/// The shape the options name (box_size, mesh_file or shape); throws on a bad mesh.
+ShapeModel build_model(const GatherOptions& o);
+
+struct RestPose {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, body frame
+  double height = 0.0;      ///< m: the snapped face's offset, else the measured mean
+  double measured_height = 0.0;  ///< mean over the drops, m
+  double height_std = 0.0;  ///< m
+  double frequency = 0.0;   ///< fraction of the settled drops
+  int count = 0;
+  bool snapped = false;     ///< the normal is a hull face's (the mean was within 3 degrees of it)
+};
+
+/// One impact's normalised outcome: W+ L/|V-| (3), (V+ - V_particle+)/|V-| (3).
+using Response = std::array<double, 6>;
+
+struct GatherResult {
+  GatherOptions options;
+  ShapeModel model;
+  std::string ground;  ///< "box" or "plane"
+  // h_coll
+  std::vector<double> height_mean, height_std;
+  // responses
+  std::vector<std::vector<double>> axes;  ///< 3 (scaled) or 4 (with speed) axes, in table order
+  std::vector<double> response_mean, response_std;  ///< cells x 6, row-major in the axes
+  long long response_trials = 0;
+  long long time_limited = 0;
+  double max_penetration = 0.0;
+  // rest poses
+  std::vector<RestPose> rest;  ///< kept poses, most frequent first
+  std::vector<RestPose> rest_rare;  ///< clusters at or below the frequency cut
+  int settled = 0, unsettled = 0;
+  double mean_settle_time = 0.0;  ///< s of simulation, over the settled drops
+  // timings, s
+  double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
+};
+
+/// Runs the gathering (deterministic for a given options.seed, whatever options.threads).
+GatherResult gather(const GatherOptions& options);
+
+/// One response trial (exposed for the checks and tests): cell coordinates, speed, trial index.
+struct ResponseTrial {
+  Response value{};
+  bool time_limited = false;
+  double max_penetration = 0.0;
+  int steps = 0;
+};
+ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, double cos_theta, double cos_phi,
+                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index);
+
+/// One h_coll flight: the centre height at first contact.
+double height_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index);
+
+/// The float (Scalar) values written to the header, and their 16-bit quantisation.
+struct Quantized {
+  float scale = 1.0f, offset = 0.0f;
+  std::vector<std::int16_t> q;
+  double worst_error = 0.0;  ///< largest |dequantised - float value|, as the runtime computes it
+};
+Quantized quantize(const std::vector<float>& values);
+
+/// The generated header. `command` is the command line recorded in it.
+std::string header_text(const GatherResult& r, const std::string& command);
+/// The JSON dump (pretty-printed, 2-space indent, trailing newline).
+std::string json_text(const GatherResult& r, const std::string& command);
+/// A short human summary for stdout.
+std::string summary_text(const GatherResult& r);
+
+/// `gather --speed-check`: normalised response means at several |V-| for a few cells (markdown).
+std::string speed_check_report(const GatherOptions& o, const std::vector<double>& speeds, int trials);
+/// `gather --step-check`: the statistics of a small gathering at dt and dt/2 (markdown).
+std::string step_check_report(const GatherOptions& o);
+/// The reference-settings check: a face-down cube at normal incidence, Bullet's defaults vs ours.
+std::string settings_check_report(const GatherOptions& o);
+
+}  // namespace statsim::tools::ref3d

@@ -1,0 +1,226 @@
+#include "ref3d/ref3d.hpp"
+
+#include "common/atomic_file.hpp"
+#include "ref3d/gather.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <ostream>
+#include <sstream>
+
+namespace statsim::tools {
+
+namespace {
+
+using namespace ref3d;
+
+// The statsim command as written in generated files (run from the repository root).
+constexpr const char* kStatsim = "build/bin/statsim";
+
+std::string quote(const std::string& s)
+{
+  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./,+=:") ==
+                        std::string::npos)
+    return s;
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct GatherCommand {
+  GatherOptions options;
+  std::string layout = "scaled";
+  std::string precision = "f32";
+  std::string out;
+  std::string json;
+  bool quiet = false;
+  bool speed_check = false;
+  bool step_check = false;
+  bool settings_check = false;
+  std::vector<double> check_speeds = {0.5, 1, 2, 4, 8};
+  int check_trials = 200;
+  std::ostream* out_stream = &std::cout;
+  std::ostream* err_stream = &std::cerr;
+};
+
+// The options that do not change the output (threads, progress, the JSON dump) are left out of
+// the recorded command, so that it is the same whatever they were.
+std::string recorded_command(const CLI::App& sub)
+{
+  std::string cmd = std::string(kStatsim) + " gather";
+  for (const CLI::Option* opt : sub.get_options()) {
+    const std::string name = opt->get_name(false, true);
+    if (opt->count() == 0 || name.rfind("--", 0) != 0) continue;
+    if (name == "--threads" || name == "--quiet" || name == "--json" || name == "--help") continue;
+    if (opt->get_type_size() == 0) {
+      cmd += " " + name;
+      continue;
+    }
+    std::string value;
+    for (const std::string& r : opt->results()) value += (value.empty() ? "" : ",") + r;
+    cmd += " " + name + " " + quote(value);
+  }
+  return cmd;
+}
+
+void run(const GatherCommand& c, const CLI::App& sub)
+{
+  std::ostream& out = *c.out_stream;
+  std::ostream& err = *c.err_stream;
+  try {
+    GatherOptions o = c.options;
+    o.progress = !c.quiet;
+    o.with_speed = c.layout == "paper";
+    o.i16 = c.precision == "i16";
+    validate_gather_options(o);
+    if (c.speed_check || c.step_check || c.settings_check) {
+      std::string report;
+      if (c.settings_check) report += settings_check_report(o) + "\n";
+      if (c.speed_check) report += speed_check_report(o, c.check_speeds, c.check_trials) + "\n";
+      if (c.step_check) report += step_check_report(o) + "\n";
+      if (!c.out.empty()) write_file_atomic(c.out, report);
+      out << report;
+      out.flush();
+      return;
+    }
+    if (c.out.empty()) throw std::runtime_error("--out FILE is required");
+    // Fail before the long run, not after it.
+    auto parent = [](const std::string& f) {
+      const std::filesystem::path p = std::filesystem::path(f).parent_path();
+      return p.empty() ? std::filesystem::path(".") : p;
+    };
+    ensure_writable_directory(parent(c.out));
+    if (!c.json.empty()) ensure_writable_directory(parent(c.json));
+    const std::string command = recorded_command(sub);
+    const GatherResult r = gather(o);
+    const std::string header = header_text(r, command);
+    if (!c.json.empty()) write_file_atomic(c.json, json_text(r, command));
+    try {
+      write_file_atomic(c.out, header);
+    } catch (...) {
+      // Both files or neither.
+      if (!c.json.empty()) {
+        std::error_code ec;
+        std::filesystem::remove(c.json, ec);
+      }
+      throw;
+    }
+    out << summary_text(r);
+    out << "wrote " << c.out << (c.json.empty() ? std::string() : " and " + c.json) << "\n";
+    out.flush();
+  } catch (const std::exception& e) {
+    err << "statsim gather: error: " << e.what() << "\n";
+    err.flush();
+    throw CLI::RuntimeError(1);
+  }
+}
+
+void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
+{
+  auto c = std::make_shared<GatherCommand>();
+  c->out_stream = out;
+  c->err_stream = err;
+  GatherOptions& o = c->options;
+  ReferenceSettings& s = o.reference;
+  CLI::App* sub = app.add_subcommand(
+      "gather",
+      "Gather a 3D shape's statistical signature with Bullet (paper 3.2: h_coll, response tables, rest poses) "
+      "and write it as a C++ table");
+  auto* shape = sub->add_option("--shape", o.shape, "Built-in shape: box, lshape or bunny (tools/meshes/NAME.obj)")
+                    ->check(CLI::IsMember({"box", "lshape", "bunny"}))
+                    ->capture_default_str();
+  auto* mesh = sub->add_option("--mesh", o.mesh_file, "Any closed, outward-wound OBJ mesh (btGImpactMeshShape)")
+                   ->excludes(shape);
+  sub->add_option("--box-size", o.box_size, "A box of this size X,Y,Z in m instead (btBoxShape)")
+      ->delimiter(',')
+      ->expected(3)
+      ->excludes(shape)
+      ->excludes(mesh);
+  sub->add_option("--layout", c->layout,
+                  "Response axes: scaled = (cos theta, cos phi, spin ratio), impacts at --speed; "
+                  "paper = with the speed |V-| as a fourth axis (26 speeds)")
+      ->check(CLI::IsMember({"scaled", "paper"}))
+      ->capture_default_str();
+  sub->add_option("--trials", o.trials, "Impacts per response cell (>= 2)")->capture_default_str();
+  sub->add_option("--height-trials", o.height_trials, "Flights per h_coll sample (>= 2)")->capture_default_str();
+  sub->add_option("--rest-drops", o.rest_drops, "Drops for the rest poses")->capture_default_str();
+  sub->add_option("--seed", o.seed, "Random seed (same seed, same bytes, any --threads)")->capture_default_str();
+  sub->add_option("--precision", c->precision, "Response tables as f32 or as i16 with per-table scale and offset")
+      ->check(CLI::IsMember({"f32", "i16"}))
+      ->capture_default_str();
+  sub->add_option("--out", c->out, "Output header (tables/NAME.hpp); with a check, the report");
+  sub->add_option("--json", c->json, "Also dump the signature as JSON to this file");
+  sub->add_option("--threads", o.threads, "Worker threads (0 = all hardware threads)")->capture_default_str();
+  sub->add_option("--name", o.name, "Table name (default: the shape's name)");
+  sub->add_option("--speed", o.speed, "|V-| of the impacts of the scaled layout, m/s")->capture_default_str();
+  sub->add_option("--speeds", o.speeds, "Speed axis of --layout paper, m/s (comma-separated)")->delimiter(',');
+  sub->add_option("--cos-theta", o.cos_theta, "Response axis: cos theta samples, increasing, in (0, 1]")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--cos-phi", o.cos_phi, "Response axis: cos phi samples, increasing, in [-1, 1]")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--spin-ratios", o.spin_ratios, "Response axis: spin ratios |W-| L / |V-|, increasing, >= 0")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--height-ratios", o.height_ratios, "h_coll axis: spin ratios, increasing, >= 0")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--restitution", s.restitution, "Coefficient of restitution (reference and V_particle+)")
+      ->capture_default_str();
+  sub->add_option("--friction", s.friction, "Coulomb friction coefficient (reference and V_particle+)")
+      ->capture_default_str();
+  sub->add_option("--restitution-threshold", s.restitution_threshold,
+                  "Approach speed below which contacts do not bounce, m/s (reference and V_particle+)")
+      ->capture_default_str();
+  sub->add_option("--rolling-resistance", o.rolling_resistance,
+                  "Rolling resistance written to the signature's material (used by the runtime's spheres only)")
+      ->capture_default_str();
+  sub->add_option("--dt", s.dt, "Bullet time step, s")->capture_default_str();
+  sub->add_option("--solver-iterations", s.solver_iterations, "Bullet solver iterations")->capture_default_str();
+  sub->add_option("--margin", s.margin, "Collision margin of the body's Bullet shape, m")->capture_default_str();
+  sub->add_option("--density", o.density, "Density, kg/m^3 (sets the recorded mass only)")->capture_default_str();
+  sub->add_flag("--quiet", c->quiet, "No progress on stderr");
+  sub->add_flag("--settings-check", c->settings_check,
+                "Print the reference-settings check (a face-down cube at normal incidence) instead of gathering");
+  sub->add_flag("--speed-check", c->speed_check,
+                "Print normalised response means at several |V-| for a few cells instead of gathering");
+  sub->add_flag("--step-check", c->step_check,
+                "Print the statistics of a small gathering at --dt and --dt/2 instead of gathering");
+  sub->add_option("--check-speeds", c->check_speeds, "Speeds of --speed-check, m/s")->delimiter(',')->capture_default_str();
+  sub->add_option("--check-trials", c->check_trials, "Impacts per cell and speed of --speed-check")->capture_default_str();
+  sub->callback([c, sub]() { run(*c, *sub); });
+}
+
+}  // namespace
+
+void register_ref3d_commands(CLI::App& app)
+{
+  add_gather(app, &std::cout, &std::cerr);
+}
+
+int run_gather_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err)
+{
+  CLI::App app{"statsim"};
+  app.require_subcommand(1);
+  add_gather(app, &out, &err);
+  std::vector<std::string> argv = {"gather"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::reverse(argv.begin(), argv.end());  // CLI11's vector form takes the arguments in reverse
+  try {
+    app.parse(argv);
+  } catch (const CLI::ParseError& e) {
+    std::ostringstream o, x;
+    const int rc = app.exit(e, o, x);
+    out << o.str();
+    err << x.str();
+    return rc;
+  }
+  return 0;
+}
+
+}  // namespace statsim::tools
