@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The main job: runs the demo programs on the committed tables, from a built tree.
+# The main job: runs the demo programs on the committed tables, from a built tree (the
+# paper's scenes: Figures 1, 5, 6 and 7, and the 2D drop).
 #   tools/main-job.sh [BUILD_DIR]   (default: build)
 set -euo pipefail
 bin="${1:-build}/bin"
@@ -17,3 +18,5 @@ run sphere_pile
 run drop2d --png "$out/drop2d.png"
 run drop_boxes
 run drop_lshapes
+run rest_conditions
+run bunnies 10000
