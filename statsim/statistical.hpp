@@ -102,7 +102,7 @@ Scalar kinetic_energy_per_mass(const SignatureView<D>& sig, const typename Space
 
 /// What `statistical_response` did.
 struct ResponseOutcome {
-  bool applied = false;         ///< the body was approaching and got a new v and w
+  bool applied = false;         ///< the body was approaching; v and w were replaced
   bool energy_clamped = false;  ///< the sample had more kinetic energy than the contact, and was scaled
 };
 
