@@ -636,8 +636,11 @@ std::string shape_description(const GatherResult& r)
       s = "btCompoundShape of " + std::to_string(m.boxes.size()) + " btBoxShapes (tools/mesh/shapes.hpp)";
       break;
     case ShapeKind::mesh:
-      s = "btGImpactMeshShape of the full mesh (" + std::to_string(m.body_mesh.vertices.size()) + " vertices, " +
-          std::to_string(m.body_mesh.triangles.size()) + " triangles)";
+      if (r.options.reference.mesh_hull)
+        s = "btConvexHullShape of the mesh's convex hull (" + std::to_string(m.hull.size()) + " vertices)";
+      else
+        s = "btGImpactMeshShape of the full mesh (" + std::to_string(m.body_mesh.vertices.size()) + " vertices, " +
+            std::to_string(m.body_mesh.triangles.size()) + " triangles)";
       break;
   }
   return s + ", margin " + num(margin) + " m; ground: " +
@@ -938,6 +941,16 @@ std::string speed_check_report(const GatherOptions& options, const std::vector<d
   return s.str();
 }
 
+namespace {
+// A time step for humans: "1/60" when 1/dt is a whole number, else the decimal.
+std::string step_name(double dt)
+{
+  const double inv = 1.0 / dt;
+  if (std::fabs(inv - std::nearbyint(inv)) < 1e-9 * inv) return "1/" + num(std::nearbyint(inv));
+  return num(dt);
+}
+}  // namespace
+
 std::string step_check_report(const GatherOptions& options)
 {
   GatherOptions base = options;
@@ -964,7 +977,7 @@ std::string step_check_report(const GatherOptions& options)
   s << "Time step (" << fine.model.name << "): a small gathering at each dt, the same random trials: "
     << fine.response_mean.size() / 6 << " response cells (cos theta 0.25, 0.7, 1; cos phi -1, 0, 1; s 0, 1, 4, 8) x "
     << options.trials << " impacts at " << num(options.speed) << " m/s, and " << options.rest_drops
-    << " rest drops. Response change: the largest |difference| of a normalised mean from the dt = " << num(steps.back())
+    << " rest drops. Response change: the largest |difference| of a normalised mean from the dt = " << step_name(steps.back())
     << " s run, and that difference over its standard error (unpaired). h_coll does not depend on dt (exact free flight).\n\n";
   s << "| dt (s) | drops settled | mean time to settle (s) | impacts time-limited | largest response change | in standard errors |\n";
   s << "|---|---|---|---|---|---|\n";
@@ -978,7 +991,7 @@ std::string step_check_report(const GatherOptions& options)
       worst = std::max(worst, d);
       if (se > 0) worst_z = std::max(worst_z, d / se);
     }
-    s << "| " << num(steps[k]) << " | " << a.settled << " / " << (a.settled + a.unsettled) << " | "
+    s << "| " << step_name(steps[k]) << " | " << a.settled << " / " << (a.settled + a.unsettled) << " | "
       << fmt("%.2f", a.mean_settle_time) << " | " << a.time_limited << " | "
       << (k + 1 == runs.size() ? std::string("-") : fmt("%.4f", worst)) << " | "
       << (k + 1 == runs.size() ? std::string("-") : fmt("%.2f", worst_z)) << " |\n";
@@ -987,7 +1000,7 @@ std::string step_check_report(const GatherOptions& options)
   std::vector<RestPose> poses = fine.rest;
   poses.insert(poses.end(), fine.rest_rare.begin(), fine.rest_rare.end());
   s << "\n| rest pose (body-frame up) | h_rest (m) |";
-  for (double d : steps) s << " frequency at dt " << num(d) << " |";
+  for (double d : steps) s << " frequency at dt " << step_name(d) << " |";
   s << "\n|---|---|";
   for (std::size_t k = 0; k < steps.size(); ++k) s << "---|";
   s << "\n";

@@ -35,6 +35,7 @@ struct GatherCommand {
   GatherOptions options;
   std::string layout = "scaled";
   std::string precision = "f32";
+  std::string mesh_shape = "gimpact";
   std::string out;
   std::string json;
   bool quiet = false;
@@ -76,6 +77,7 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.progress = !c.quiet;
     o.with_speed = c.layout == "paper";
     o.i16 = c.precision == "i16";
+    o.reference.mesh_hull = c.mesh_shape == "hull";
     validate_gather_options(o);
     if (c.speed_check || c.step_check || c.settings_check) {
       std::string report;
@@ -183,6 +185,10 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   sub->add_option("--dt", s.dt, "Bullet time step, s")->capture_default_str();
   sub->add_option("--solver-iterations", s.solver_iterations, "Bullet solver iterations")->capture_default_str();
   sub->add_option("--margin", s.margin, "Collision margin of the body's Bullet shape, m")->capture_default_str();
+  sub->add_option("--mesh-shape", c->mesh_shape,
+                  "Bullet shape of a mesh: gimpact (the full mesh) or hull (its convex hull; the same against a plane)")
+      ->check(CLI::IsMember({"gimpact", "hull"}))
+      ->capture_default_str();
   sub->add_option("--density", o.density, "Density, kg/m^3 (sets the recorded mass only)")->capture_default_str();
   sub->add_flag("--quiet", c->quiet, "No progress on stderr");
   sub->add_flag("--settings-check", c->settings_check,

@@ -15,19 +15,24 @@ enum class Ground {
   box,    ///< a large static btBoxShape (box-box contacts come from btBoxBoxDetector, all 4 at once)
 };
 
-/// Reference settings. Defaults and why (the evidence is in the README / `gather --speed-check`):
-/// - restitution 0.3, friction 0.5 (Coulomb, combined with the ground's 1: Bullet multiplies);
-/// - restitution threshold 0.2 m/s (Bullet's default; the runtime's V_particle+ uses the same);
-/// - dt 1/1000 s: the bunny jitters at 1/60, and the statistics no longer change when halved;
-/// - 30 solver iterations, no warm starting (an impact is a fresh contact: warm starting carries
-///   impulses of the previous step into a resolving contact);
-/// - split impulse always on (penetration recovery never adds real velocity: with Bullet's default
-///   threshold of -0.04 m, Baumgarte's position correction adds velocity for penetrations below
-///   4 cm, which is most of them for a 20 cm body);
-/// - margins 0.5 mm: Bullet's 4 cm default rounds a 20 cm box's corners by a fifth of its size;
-/// - ground: a static box for box and compound shapes (btBoxBoxDetector gives the whole contact
-///   face at once; against a plane Bullet's convex-plane algorithm adds one point per step, so a
-///   face-down cube is hit on one corner and leaves spinning), a plane for meshes.
+/// Reference settings. Defaults and why (evidence: tools/ref3d/README.md and
+/// `statsim gather --settings-check | --speed-check | --step-check`):
+/// - restitution 0.3, friction 0.5 on the body, 1 and 1 on the ground (Bullet multiplies), so
+///   contacts use exactly the body's values, which the signature records for V_particle+;
+/// - restitution threshold 0.02 m/s (Bullet: 0.2): 0.2 makes slow secondary contacts inelastic,
+///   so normalised rebounds at 0.5 m/s differed from those at 2 m/s; 0.02 is above 2 g dt, so
+///   resting bodies do not bounce;
+/// - dt 1 ms: the statistics no longer change when it is halved (at 1/60 s they are far off);
+/// - split impulse always (Bullet splits only below 4 cm of penetration; above, Baumgarte's
+///   position correction adds real velocity in proportion to the penetration, i.e. to the speed);
+/// - no speculative contacts (contact processing threshold 0): a point reported before the touch
+///   stops the approach a step early and the touch then sees a slower approach, losing restitution;
+/// - the convex-plane manifold built 4 points at a time (Bullet: one new point per step, so a
+///   face-down cube is hit on one corner and leaves spinning);
+/// - 30 solver iterations, no warm starting (impacts are fresh contacts);
+/// - margin 0.5 mm (Bullet: 4 cm, which GImpact adds around a mesh and GJK around a box's core);
+/// - ground: a static box for box and compound shapes (btBoxBoxDetector: the whole contact face
+///   at once), a plane for meshes (GImpact tests every mesh vertex against it).
 struct ReferenceSettings {
   double restitution = 0.3;
   double friction = 0.5;
