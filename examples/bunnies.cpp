@@ -67,10 +67,15 @@ int main(int argc, char** argv)
   if (ms < 0) return 1;
   demo::summary("bunnies", world, shape, steps, ms);
   float lowest = 1e9f;
-  for (std::uint32_t i = 0; i < world.body_count(); ++i)
-    lowest = std::min(lowest, world.body(i).position.z() - world.body(i).radius);
-  std::printf("  after %.1f s: %.1f%% asleep, deepest sphere overlap %.1f%% of the radius, lowest sphere bottom %+.5f m\n",
+  std::uint32_t below = 0;  // spheres reaching more than 1 mm into the ground
+  for (std::uint32_t i = 0; i < world.body_count(); ++i) {
+    const float bottom = world.body(i).position.z() - world.body(i).radius;
+    lowest = std::min(lowest, bottom);
+    below += bottom < -0.001f;
+  }
+  std::printf("  after %.1f s: %.1f%% asleep, deepest sphere overlap %.1f%% of the radius, lowest sphere bottom %+.5f m "
+              "(%u below the ground)\n",
               double(steps) / 60, 100.0 * world.count(statsim::MotionState::asleep) / double(world.body_count()),
-              100.0 * double(deepest_overlap(world)), double(lowest));
+              100.0 * double(deepest_overlap(world)), double(lowest), below);
   return 0;
 }

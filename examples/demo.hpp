@@ -2,9 +2,12 @@
 // summary, and writing per-frame transforms. Not a demo itself.
 //
 // Frame files are CSV with the header line
-//   frame,time,body,shape,x,y,z,qw,qx,qy,qz,state
-// one row per body per written frame: positions in metres (centre of mass, z up), orientation
-// as a unit quaternion (body to world), state 0 moving, 1 settling, 2 asleep.
+//   frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius
+// one row per body per written frame: the step, the time after it (s), the body's index, its
+// shape's name (the signature's: box, lshape, bunny; sphere for a plain sphere), position in metres (centre of mass, z up),
+// orientation as a unit quaternion (body to world), state 0 moving, 1 settling, 2 asleep, and the
+// current collision-sphere radius (m). `statsim render` and `statsim export` read these files
+// (README "Pictures" documents the format).
 #pragma once
 
 #include "statsim/world3.hpp"
@@ -90,7 +93,7 @@ inline double run(WorldCore3& w, const Options& o, int& steps_done)
       std::fprintf(stderr, "cannot write %s\n", o.frames);
       return -1;
     }
-    std::fprintf(f, "frame,time,body,shape,x,y,z,qw,qx,qy,qz,state\n");
+    std::fprintf(f, "frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius\n");
   }
   const float dt = 1.0f / 60;
   double seconds = 0;
@@ -104,10 +107,10 @@ inline double run(WorldCore3& w, const Options& o, int& steps_done)
     if (f && s % o.every == 0)
       for (std::uint32_t i = 0; i < w.body_count(); ++i) {
         const Body3& b = w.body(i);
-        std::fprintf(f, "%d,%.5f,%u,%u,%.6f,%.6f,%.6f,%.7f,%.7f,%.7f,%.7f,%d\n", s, double(s + 1) * double(dt), i,
-                     unsigned(b.shape), double(b.position.x()), double(b.position.y()), double(b.position.z()),
-                     double(b.orientation.w()), double(b.orientation.x()), double(b.orientation.y()),
-                     double(b.orientation.z()), int(b.state));
+        std::fprintf(f, "%d,%.5f,%u,%s,%.6f,%.6f,%.6f,%.7f,%.7f,%.7f,%.7f,%d,%.6f\n", s, double(s + 1) * double(dt), i,
+                     w.shape(b.shape).statistical ? w.shape(b.shape).signature.name : "sphere", double(b.position.x()), double(b.position.y()),
+                     double(b.position.z()), double(b.orientation.w()), double(b.orientation.x()),
+                     double(b.orientation.y()), double(b.orientation.z()), int(b.state), double(b.radius));
       }
   }
   if (f) std::fclose(f);

@@ -2,10 +2,12 @@
 // signatures from the committed tables (tables/square2d.hpp, tables/lshape2d.hpp). Prints a
 // summary and writes a PNG of the final frame.
 //
-//   drop2d [--n N] [--png FILE] [--seed S]
-//     --n     bodies of each shape (default 100, at most 500)
-//     --png   picture of the final frame (default drop2d.png; "-" for none)
-//     --seed  seed of the initial states and of the world (default 1)
+//   drop2d [--n N] [--png FILE] [--seed S] [--frames FILE.csv] [--every K]
+//     --n       bodies of each shape (default 100, at most 500)
+//     --png     picture of the final frame (default drop2d.png; "-" for none)
+//     --seed    seed of the initial states and of the world (default 1)
+//     --frames  per-frame transforms, every K-th step (default 6), in the demos' CSV format
+//               (examples/demo.hpp): x, y with y up, z = 0, the turn as a quaternion about z
 #include "statsim/world2.hpp"
 #include "tables/lshape2d.hpp"
 #include "tables/square2d.hpp"
@@ -23,6 +25,7 @@
 #pragma GCC diagnostic pop
 #endif
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -98,12 +101,16 @@ int main(int argc, char** argv)
   long n = 100;
   const char* png = "drop2d.png";
   unsigned long long seed = 1;
+  const char* frames = nullptr;
+  int every = 6;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--n") && i + 1 < argc) n = std::strtol(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--png") && i + 1 < argc) png = argv[++i];
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = argv[++i];
+    else if (!std::strcmp(argv[i], "--every") && i + 1 < argc) every = std::max(1, int(std::strtol(argv[++i], nullptr, 10)));
     else {
-      std::fprintf(stderr, "usage: drop2d [--n N] [--png FILE|-] [--seed S]\n");
+      std::fprintf(stderr, "usage: drop2d [--n N] [--png FILE|-] [--seed S] [--frames FILE.csv] [--every K]\n");
       return 2;
     }
   }
@@ -144,6 +151,15 @@ int main(int argc, char** argv)
     }
   }
 
+  std::FILE* csv = nullptr;
+  if (frames) {
+    csv = std::fopen(frames, "w");
+    if (!csv) {
+      std::fprintf(stderr, "drop2d: cannot write %s\n", frames);
+      return 1;
+    }
+    std::fprintf(csv, "frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius\n");
+  }
   const float dt = 1.0f / 60;
   const int max_steps = 60 * 40;
   int steps = 0;
@@ -152,9 +168,19 @@ int main(int argc, char** argv)
     const auto t0 = std::chrono::steady_clock::now();
     const StepResult r = world.step(dt);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (csv && steps % every == 0)
+      for (std::uint32_t i = 0; i < world.body_count(); ++i) {
+        const Body2& b = world.body(i);
+        // A turn by angle a about z: quaternion (cos a/2, 0, 0, sin a/2).
+        const double half = 0.5 * double(b.orientation.angle());
+        std::fprintf(csv, "%d,%.5f,%u,%s,%.6f,%.6f,0,%.7f,0,0,%.7f,%d,%.6f\n", steps, double(steps + 1) * double(dt), i,
+                     world.shape(b.shape).signature.name, double(b.position.x()), double(b.position.y()),
+                     std::cos(half), std::sin(half), int(b.state), double(b.radius));
+      }
     ++steps;
     if (r.overflow) std::fprintf(stderr, "drop2d: pair buffer overflow (%u dropped)\n", r.pairs_dropped);
   }
+  if (csv) std::fclose(csv);
 
   std::printf("drop2d: %ld squares and %ld L-shapes, %d steps of 1/60 s, %.4f ms per step\n", n, n, steps,
               1e3 * seconds / steps);

@@ -2,7 +2,9 @@
 // conditions (paper 3.4). Without them it stops in whatever orientation it has, on a sphere of
 // radius h_coll, so it floats above the floor; with them it turns into a rest pose and settles at
 // that pose's h_rest.
-//   rest_conditions [--seed S]
+//   rest_conditions [--seed S] [--frames FILE.csv] [--frames-without FILE.csv]
+//     --frames          frames of the run with resting conditions
+//     --frames-without  frames of the run without them
 #include "demo.hpp"
 #include "tables/bunny.hpp"
 
@@ -13,7 +15,16 @@ statsim::World3<1> worlds[2];
 int main(int argc, char** argv)
 {
   demo::Options o;
-  if (!demo::parse(argc, argv, o, "rest_conditions [--seed S] [--frames FILE.csv]")) return 2;
+  const char* frames_without = nullptr;
+  for (int i = 1; i + 1 < argc; ++i)
+    if (!std::strcmp(argv[i], "--frames-without")) {
+      frames_without = argv[i + 1];
+      for (int j = i; j + 2 < argc; ++j) argv[j] = argv[j + 2];  // drop the pair before demo::parse
+      argc -= 2;
+      break;
+    }
+  if (!demo::parse(argc, argv, o, "rest_conditions [--seed S] [--frames FILE.csv] [--frames-without FILE.csv]"))
+    return 2;
   const statsim::SignatureView<3> sig = statsim::tables::bunny.view();
   for (int k = 0; k < 2; ++k) {
     statsim::WorldDef3 def;
@@ -28,7 +39,7 @@ int main(int argc, char** argv)
     int steps = 0;
     demo::Options run = o;
     run.steps = 60 * 30;
-    if (k == 0 && o.frames) run.frames = nullptr;  // frames of the run with resting conditions
+    if (k == 0) run.frames = frames_without;
     if (demo::run(w, run, steps) < 0) return 1;
     const statsim::Body3& b = w.body(0);
     const statsim::Vector3 up = b.orientation.conjugate() * statsim::Vector3(0, 0, 1);  // world up in the body frame

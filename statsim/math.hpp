@@ -83,7 +83,13 @@ bool finite(const Eigen::Matrix<Scalar, R, 1>& v)
 inline bool finite(const Quaternion& q) { return finite(q.coeffs()); }
 inline bool finite(const Rot2& r) { return std::isfinite(r.c) && std::isfinite(r.s); }
 
-inline Scalar squared_norm(const Quaternion& q) { return q.coeffs().squaredNorm(); }
+/// Written out in the order of Eigen's scalar reduction of (x, y, z, w): its SSE reduction adds
+/// in another order, and a build with vectorisation would round differently from one without
+/// (a Cortex-M build, say).
+inline Scalar squared_norm(const Quaternion& q)
+{
+  return (q.x() * q.x() + q.y() * q.y()) + (q.z() * q.z() + q.w() * q.w());
+}
 inline Scalar squared_norm(const Rot2& r) { return r.squared_norm(); }
 inline Scalar squared_norm(Scalar w) { return w * w; }
 template <int R>
@@ -98,6 +104,16 @@ inline Vector2 cross(Scalar w, const Vector2& r) { return {-w * r.y(), w * r.x()
 /// r x j: in 2D the scalar z component.
 inline Vector3 moment(const Vector3& r, const Vector3& j) { return r.cross(j); }
 inline Scalar moment(const Vector2& r, const Vector2& j) { return r.x() * j.y() - r.y() * j.x(); }
+
+/// The Hamilton product a b, written out for the same reason as squared_norm(Quaternion): the
+/// terms in the order of Eigen's scalar product, whatever the build vectorises.
+inline Quaternion product(const Quaternion& a, const Quaternion& b)
+{
+  return Quaternion(a.w() * b.w() - a.x() * b.x() - a.y() * b.y() - a.z() * b.z(),
+                    a.w() * b.x() + a.x() * b.w() + a.y() * b.z() - a.z() * b.y(),
+                    a.w() * b.y() + a.y() * b.w() + a.z() * b.x() - a.x() * b.z(),
+                    a.w() * b.z() + a.z() * b.w() + a.x() * b.y() - a.y() * b.x());
+}
 
 /// Rescales a rotation to unit length (sqrt is exactly rounded, so this is portable).
 inline Quaternion normalized(const Quaternion& q)

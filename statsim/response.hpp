@@ -108,16 +108,42 @@ bool particle_response(ContactSide<D> a, ContactSide<D> b, const typename Space<
 }
 
 /// Body against a static plane with unit normal `n` (pointing out of the plane, towards the
-/// body). Mass cancels out, so none is needed.
+/// body). Mass cancels out, so none is needed. The same rule as `particle_response` with a static,
+/// spinless first side and a unit-mass body, written out because resting bodies meet the ground
+/// in every contact pass: the terms of the static side vanish.
 template <int D>
 bool particle_plane_response(typename Space<D>::Vec& velocity, typename Space<D>::Spin& spin, Scalar radius,
                              const typename Space<D>::Vec& n, const Material& m, Scalar restitution_threshold)
 {
-  typename Space<D>::Vec plane_velocity = Space<D>::Vec::Zero();
-  typename Space<D>::Spin plane_spin = Space<D>::zero_spin();
-  // The plane is side a (static, normal from it to the body), the body side b with unit mass.
-  return particle_response<D>({plane_velocity, plane_spin, 0, 0}, {velocity, spin, 1, radius}, n, m,
-                              restitution_threshold);
+  using Vec = typename Space<D>::Vec;
+  const Scalar inv_k = Scalar(1) / Space<D>::inertia_factor;
+  const Vec r = n * -radius;
+  const Vec u = velocity + detail::cross(spin, r);
+  const Scalar vn = u.dot(n);
+  if (vn >= 0) return false;
+  const Scalar compliance = radius > 0 ? 1 + inv_k : Scalar(1);
+  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
+  const Scalar jn = -(1 + e) * vn;
+  Vec impulse = n * jn;
+  const Vec ut = u - n * vn;
+  const Scalar slip = ut.norm();
+  if (slip > Scalar(0)) {
+    const Scalar jt_stick = slip / compliance;
+    const Scalar jt_slide = m.friction * jn;
+    const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
+    impulse -= ut * (jt / slip);
+  }
+  velocity += impulse;
+  if (radius > 0) spin += detail::moment(r, impulse) * (inv_k / (radius * radius));
+  if (m.rolling_resistance > 0) {
+    const Vec vt = velocity - n * velocity.dot(n);
+    const Scalar speed = vt.norm();
+    const Scalar cut = m.rolling_resistance * jn;
+    const Scalar f = speed > cut ? 1 - cut / speed : Scalar(0);
+    velocity += vt * (f - 1);
+    spin = spin * f;
+  }
+  return true;
 }
 
 /// V_particle+ of the statistical response (paper 3.3.2 step 7): the velocity a point particle

@@ -22,6 +22,7 @@ enum class Status : std::uint8_t {
   invalid_shape,         ///< shape id does not name a shape of this world
   invalid_body,          ///< body id does not name a body of this world
   invalid_parameter,     ///< a world parameter is out of its documented range
+  out_of_range,          ///< a finite value beyond the runtime's limits (`statsim::limits`)
 };
 
 /// Short, stable name of a status, for messages ("capacity_exceeded").
@@ -41,6 +42,7 @@ constexpr const char* to_string(Status s)
     case Status::invalid_shape: return "invalid_shape";
     case Status::invalid_body: return "invalid_body";
     case Status::invalid_parameter: return "invalid_parameter";
+    case Status::out_of_range: return "out_of_range";
   }
   return "unknown";
 }

@@ -8,13 +8,14 @@
 ///
 /// A step, in order:
 ///  1. integrate awake bodies (semi-implicit Euler; orientation without trigonometry);
-///  2. broad phase: sweep-and-prune on the bounding radius;
+///  2. broad phase (hashed grid or sweep-and-prune) on the bounding radius;
 ///  3. impact pass: body-plane then body-body contacts get the response (particle response for
 ///     now); planes push bodies out of them;
 ///  4. support passes (`WorldDef::support_iterations`): inelastic, removing approach velocity
 ///     left at resting contacts, planes last;
 ///  5. shock pass: contacts from the bottom up, the lower body immovable; overlaps between bodies
-///     are corrected here, softly (`allowed_overlap`, `overlap_correction`);
+///     are corrected here, softly (`allowed_overlap`, `overlap_correction`), then again in
+///     `position_iterations` passes that only move bodies;
 ///  6. motion state: moving, settling (slow and touching), asleep (slow for `sleep_time`).
 /// Sleeping bodies are not integrated and act as static supports until hit harder than
 /// `wake_speed`.
@@ -32,6 +33,30 @@
 #include <limits>
 
 namespace statsim {
+
+/// Limits on finite inputs. Beyond them single-precision arithmetic can overflow (a speed of
+/// 1e30 m/s squared is infinite) or lose all meaning, so calls with such values are rejected with
+/// `Status::out_of_range` (or `invalid_parameter` for `WorldDef`) and change nothing.
+namespace limits {
+constexpr Scalar coordinate = Scalar(1e6);   ///< |position component|, |plane offset|, m
+constexpr Scalar speed = Scalar(1e5);        ///< |linear velocity component|, m/s
+constexpr Scalar spin = Scalar(1e7);         ///< |angular velocity component|, rad/s
+constexpr Scalar time_step = 1;              ///< largest dt of `step`, s
+constexpr Scalar min_mass = Scalar(1e-9);    ///< kg
+constexpr Scalar max_mass = Scalar(1e9);     ///< kg
+constexpr Scalar min_radius = Scalar(1e-6);  ///< collision and bounding radius, m
+constexpr Scalar max_radius = Scalar(1e4);   ///< m
+constexpr Scalar gravity = Scalar(1e4);      ///< |gravity component|, m/s^2
+}  // namespace limits
+
+namespace detail {
+template <class V>
+bool within(const V& v, Scalar bound)
+{
+  return (v.array().abs() <= bound).all();
+}
+inline bool within(Scalar x, Scalar bound) { return std::fabs(x) <= bound; }
+}  // namespace detail
 
 /// Index of a body in its world, in order of creation.
 using BodyId = std::uint32_t;
@@ -82,7 +107,8 @@ enum class PairResponse : std::uint8_t {
 template <int D>
 struct WorldDef {
   using Vec = typename Space<D>::Vec;
-  /// Gravity, m/s^2. Default: 9.81 down the up axis (-z in 3D, -y in 2D).
+  /// Gravity, m/s^2, each component within +-`limits::gravity` (1e4). Default: 9.81 down the up
+  /// axis (-z in 3D, -y in 2D).
   Vec gravity = -Scalar(9.81) * Vec::Unit(Space<D>::up_axis);
   /// Seed of every random stream; body i draws from stream `body_stream(seed, i)`.
   std::uint64_t seed = 0x5eed5eedull;
@@ -107,6 +133,10 @@ struct WorldDef {
   int support_iterations = 4;
   /// After the support passes, one bottom-up pass that settles stacks exactly (see `step`).
   bool shock_propagation = true;
+  /// Passes after the shock pass that only push overlapping bodies apart, in its order and with
+  /// its frozen bodies, in [0, 64]; they need `shock_propagation`. A body wedged between several
+  /// others needs a few to come out of all of them. Typical: 0 to 4.
+  int position_iterations = 2;
   /// Overlap of two bodies left uncorrected, as a fraction of the sum of their radii, in [0, 0.5).
   /// Typical: 0.005 to 0.05. Resting contacts keep about this much overlap.
   Scalar allowed_overlap = Scalar(0.01);
@@ -130,7 +160,7 @@ struct WorldDef {
   Scalar rest_blend_time = Scalar(0.15);
   /// Settling bodies are turned toward their rest pose at each ground contact with an angular
   /// velocity of (sine of the remaining angle) / rest_turn_time, rad/s, capped so that the
-  /// farthest point moves at most at `settle_speed`. Seconds, > 0.
+  /// farthest point moves at most at `settle_speed`. Seconds, >= 1e-4.
   Scalar rest_turn_time = Scalar(0.1);
   /// A body turning into its rest pose may fall asleep (and snap into the pose) once the pose's
   /// normal is within this cosine of up (0.996: about 5 degrees).
@@ -138,8 +168,12 @@ struct WorldDef {
   /// A plane counts as ground for resting conditions when its normal's up component is at least
   /// this (0.9: within about 25 degrees of horizontal).
   Scalar ground_cosine = Scalar(0.9);
-  /// The broad phase: a hashed grid (default; it wins in piles) or sweep-and-prune.
-  BroadPhase broad_phase = BroadPhase::grid;
+  /// The broad phase: sweep-and-prune for small worlds and the hashed grid for large ones
+  /// (default, `automatic`), or either one always.
+  BroadPhase broad_phase = BroadPhase::automatic;
+  /// With `BroadPhase::automatic`, worlds of more bodies than this use the grid, fewer
+  /// sweep-and-prune. The measured crossover of the two is near 2,000 bodies.
+  std::uint32_t grid_above_bodies = 2048;
   /// Axis the sweep-and-prune broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
   /// along, not the up axis of a pile.
   int sweep_axis = 0;
@@ -187,6 +221,8 @@ struct Shape {
   Material material;
   bool statistical;
   SignatureView<D> signature;  ///< meaningful when `statistical`
+  /// Biases of the rest-pose basins (`rest_basin_biases`), one per rest pose.
+  std::array<Scalar, max_rest_poses> rest_bias;
 };
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
@@ -220,18 +256,20 @@ class WorldCore {
         !detail::finite(def.material.friction))
       return {Status::non_finite, 0};
     if (!(def.radius > 0) || bound < def.radius) return {Status::invalid_radius, 0};
+    if (def.radius < limits::min_radius || bound > limits::max_radius) return {Status::out_of_range, 0};
     if (!detail::finite(def.material.rolling_resistance)) return {Status::non_finite, 0};
     if (def.material.restitution < 0 || def.material.restitution > 1 || def.material.friction < 0 ||
         def.material.rolling_resistance < 0)
       return {Status::invalid_material, 0};
     if (shape_count_ == max_shapes_) return {Status::capacity_exceeded, 0};
-    shapes_[shape_count_] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}};
+    shapes_[shape_count_] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}};
     return {Status::ok, ShapeId(shape_count_++)};
   }
 
   /// Registers a statistical shape from its signature (`tables::NAME.view()`). The view is
   /// copied; the tables it points to must outlive the world (generated tables are static).
-  /// Rejected with `invalid_shape` if the signature is malformed.
+  /// Rejected with `invalid_shape` if the signature is malformed or has more than `max_rest_poses`
+  /// rest poses. Computes the rest-pose basins (`rest_basin_biases`): up to 10 ms.
   Added<ShapeId> add_shape(const SignatureView<D>& sig)
   {
     const Status s = check_signature(sig);
@@ -246,7 +284,8 @@ class WorldCore {
       rest_max = sig.rest.heights[i] > rest_max ? sig.rest.heights[i] : rest_max;
     }
     const Scalar radius = rest_max > 0 ? rest_max : sig.height.mean[0];
-    shapes_[shape_count_] = Shape<D>{radius, largest, sig.material, true, sig};
+    shapes_[shape_count_] = Shape<D>{radius, largest, sig.material, true, sig, {}};
+    rest_basin_biases<D>(sig, shapes_[shape_count_].rest_bias.data());
     return {Status::ok, ShapeId(shape_count_++)};
   }
 
@@ -255,6 +294,7 @@ class WorldCore {
   Added<PlaneId> add_plane(const Vec& normal, Scalar offset)
   {
     if (!detail::finite(normal) || !detail::finite(offset)) return {Status::invalid_plane, 0};
+    if (!detail::within(offset, limits::coordinate)) return {Status::out_of_range, 0};
     const Scalar len = normal.norm();
     if (!(len > Scalar(1e-12)) || !detail::finite(len)) return {Status::invalid_plane, 0};
     if (plane_count_ == max_planes_) return {Status::capacity_exceeded, 0};
@@ -270,6 +310,7 @@ class WorldCore {
     if (def.shape >= shape_count_) return {Status::invalid_shape, 0};
     if (!detail::finite(def.mass)) return {Status::non_finite, 0};
     if (!(def.mass > 0)) return {Status::invalid_mass, 0};
+    if (def.mass < limits::min_mass || def.mass > limits::max_mass) return {Status::out_of_range, 0};
     if (body_count_ == max_bodies_) return {Status::capacity_exceeded, 0};
 
     const BodyId id = body_count_;
@@ -302,6 +343,7 @@ class WorldCore {
   {
     if (id >= body_count_) return Status::invalid_body;
     if (!detail::finite(linear) || !detail::finite(angular)) return Status::non_finite;
+    if (!detail::within(linear, limits::speed) || !detail::within(angular, limits::spin)) return Status::out_of_range;
     Body<D>& b = bodies_[id];
     b.linear_velocity = linear;
     b.angular_velocity = angular;
@@ -323,12 +365,12 @@ class WorldCore {
   }
 
   /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` if dt
-  /// is not finite and positive; then nothing changes. Overflow of the pair buffer is reported in
+  /// is not finite and positive or exceeds `limits::time_step` (1 s); then nothing changes. Overflow of the pair buffer is reported in
   /// the result, never silent.
   StepResult step(Scalar dt)
   {
     StepResult result;
-    if (!detail::finite(dt) || !(dt > 0)) {
+    if (!detail::finite(dt) || !(dt > 0) || dt > limits::time_step) {
       result.status = Status::invalid_time_step;
       return result;
     }
@@ -351,8 +393,16 @@ class WorldCore {
     }
     if (def_.shock_propagation) {
       sort_bottom_up(touching);
+      moves_ = 0;
       resolve_pairs(touching, Pass::shock);
       resolve_planes(Pass::support);
+      // A pass after one that moved nothing would find every contact as that one did: skip it
+      // (in a resting pile, all of them).
+      for (int i = 0; i < def_.position_iterations && moves_ > 0; ++i) {
+        moves_ = 0;
+        resolve_pairs(touching, Pass::position);
+        resolve_planes(Pass::position);
+      }
     }
     update_motion_states(dt);
     result.energy_clamps = energy_clamps_step_;
@@ -449,7 +499,7 @@ class WorldCore {
     Plane<D>* planes;
     Shape<D>* shapes;
     std::uint32_t* grid_start;
-    std::uint32_t* grid_items;
+    detail::GridItem<D>* grid_items;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   };
 
@@ -481,12 +531,13 @@ class WorldCore {
       return Status::non_finite;
     if (d.restitution_threshold < 0 || d.settle_speed < 0 || d.sleep_speed < 0 || d.sleep_time < 0 ||
         d.wake_speed < 0 || d.linear_damping < 0 || d.angular_damping < 0 || d.support_iterations < 1 ||
-        d.support_iterations > 64 ||
-        (d.broad_phase != BroadPhase::grid && d.broad_phase != BroadPhase::sweep_and_prune) || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
+        d.support_iterations > 64 || d.position_iterations < 0 || d.position_iterations > 64 ||
+        (d.broad_phase != BroadPhase::grid && d.broad_phase != BroadPhase::sweep_and_prune &&
+         d.broad_phase != BroadPhase::automatic) || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
         !(d.overlap_correction > 0) || d.overlap_correction > 1 || !(d.rest_blend_time > 0) ||
         !(d.rest_turn_time > 0) || d.ground_cosine < 0 || d.ground_cosine > 1 ||
         d.rest_snap_cosine < 0 || d.rest_snap_cosine > 1 || d.spin_ratio_speed_floor < 0 || d.sweep_axis < 0 ||
-        d.sweep_axis >= D)
+        d.sweep_axis >= D || !detail::within(d.gravity, limits::gravity) || d.rest_turn_time < Scalar(1e-4))
       return Status::invalid_parameter;
     return Status::ok;
   }
@@ -499,6 +550,9 @@ class WorldCore {
     if (!(n2 > Scalar(1e-12))) return Status::zero_quaternion;
     // |q|^2 - 1 ~ 2 (|q| - 1): a tolerance of 1e-3 on the length.
     if (!(n2 > Scalar(1 - 2e-3) && n2 < Scalar(1 + 2e-3))) return Status::non_unit_quaternion;
+    if (!detail::within(x, limits::coordinate) || !detail::within(v, limits::speed) ||
+        !detail::within(w, limits::spin))
+      return Status::out_of_range;
     return Status::ok;
   }
 
@@ -513,10 +567,52 @@ class WorldCore {
         (D == 3 ? 3u : 2u) + (sig.layout == ResponseLayout::with_speed ? 1u : 0u);
     if (!sig.height.spin_ratio.values || sig.height.spin_ratio.size < 1 || r.axis_count != expected_axes ||
         r.components != (D == 3 ? 6u : 3u) || (!r.mean.f32 && !r.mean.i16) || (!r.stddev.f32 && !r.stddev.i16) ||
-        (sig.rest.count > 0 && (!sig.rest.normals || !sig.rest.heights)) || sig.rest.count >= no_rest_pose)
+        (sig.rest.count > 0 && (!sig.rest.normals || !sig.rest.heights)) || sig.rest.count > max_rest_poses)
       return Status::invalid_shape;
     for (std::uint32_t a = 0; a < r.axis_count; ++a)
       if (!r.axes[a].values || r.axes[a].size < 1) return Status::invalid_shape;
+    if ((!sig.height.mean.f32 && !sig.height.mean.i16) || (!sig.height.stddev.f32 && !sig.height.stddev.i16))
+      return Status::invalid_shape;
+    return check_signature_values(sig);
+  }
+
+  /// The numbers of a signature: every one finite, axes strictly increasing, heights positive,
+  /// rest normals unit. Table values are bounded (|x| <= 1e6: normalised responses are O(1)) so
+  /// that scaling them by a speed cannot overflow. One pass over the tables, at add_shape only.
+  static Status check_signature_values(const SignatureView<D>& sig)
+  {
+    constexpr Scalar bound = Scalar(1e6);
+    const auto bad = [bound](Scalar x) { return !(x >= -bound && x <= bound); };  // NaN is bad
+    const auto bad_axis = [&bad](const AxisView& a) {
+      for (std::uint32_t i = 0; i < a.size; ++i)
+        if (bad(a.values[i]) || (i > 0 && !(a.values[i] > a.values[i - 1]))) return true;
+      return false;
+    };
+    const Material& m = sig.material;
+    if (bad(m.restitution) || bad(m.friction) || bad(m.rolling_resistance) || bad(sig.restitution_threshold) ||
+        bad(sig.mass) || bad(sig.unit_inertia[0]) || bad(sig.unit_inertia[1]) || bad(sig.unit_inertia[2]))
+      return Status::non_finite;
+    if (m.rolling_resistance < 0 || sig.restitution_threshold < 0) return Status::invalid_material;
+    if (sig.unit_inertia[0] < 0 || sig.unit_inertia[1] < 0 || sig.unit_inertia[2] < 0) return Status::invalid_shape;
+    const HeightTableView& h = sig.height;
+    if (bad_axis(h.spin_ratio)) return Status::invalid_shape;
+    for (std::uint32_t i = 0; i < h.spin_ratio.size; ++i)
+      if (bad(h.mean[i]) || !(h.mean[i] > 0) || bad(h.stddev[i])) return Status::invalid_shape;
+    const ResponseTableView& r = sig.response;
+    std::uint32_t values = r.components;
+    for (std::uint32_t a = 0; a < r.axis_count; ++a) {
+      if (bad_axis(r.axes[a])) return Status::invalid_shape;
+      values *= r.axes[a].size;
+    }
+    if (bad(r.mean.scale) || bad(r.mean.offset) || bad(r.stddev.scale) || bad(r.stddev.offset))
+      return Status::invalid_shape;
+    for (std::uint32_t i = 0; i < values; ++i)
+      if (bad(r.mean[i]) || bad(r.stddev[i])) return Status::invalid_shape;
+    for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+      const typename Space<D>::Vec n = sig.rest.normal(i);
+      if (!detail::finite(n) || !(std::fabs(n.squaredNorm() - 1) < Scalar(2e-3))) return Status::invalid_shape;
+      if (bad(sig.rest.heights[i]) || !(sig.rest.heights[i] > 0)) return Status::invalid_shape;
+    }
     return Status::ok;
   }
 
@@ -637,7 +733,9 @@ class WorldCore {
 
   void find_pairs(StepResult& result)
   {
-    if (def_.broad_phase == BroadPhase::grid) find_pairs_grid(result);
+    const bool grid = def_.broad_phase == BroadPhase::grid ||
+                      (def_.broad_phase == BroadPhase::automatic && body_count_ > def_.grid_above_bodies);
+    if (grid) find_pairs_grid(result);
     else find_pairs_sweep(result);
     const std::uint32_t found = result.pairs_found;
     if (found > max_pairs_) {
@@ -667,28 +765,46 @@ class WorldCore {
     const auto cell = [this](std::uint32_t i, std::int32_t* c) {
       for (int k = 0; k < 3; ++k) c[k] = k < D ? grid_.cell_of(bodies_[i].position[k], grid_.inv_cell) : 0;
     };
-    grid_.build(body_count_, cell);
+    const auto item = [this](std::uint32_t i) {
+      const Body<D>& b = bodies_[i];
+      return detail::GridItem<D>{b.position, b.bounding_radius, i, b.state != MotionState::asleep ? 1u : 0u};
+    };
+    grid_.build(body_count_, cell, item);
     std::uint32_t found = 0;
     constexpr int neighbours = D == 3 ? 27 : 9;
     for (std::uint32_t i = 0; i < body_count_; ++i) {
-      if (bodies_[i].state == MotionState::asleep) continue;
+      const Body<D>& bi = bodies_[i];
+      if (bi.state == MotionState::asleep) continue;
       std::int32_t c[3];
       cell(i, c);
       std::uint32_t seen[neighbours];
       int seen_count = 0;
+      // Buckets seen so far, by their low 6 bits: a clear bit proves a bucket new without
+      // comparing it with every one before (neighbouring cells rarely share a bucket).
+      std::uint64_t seen_bits = 0;
       for (int n = 0; n < neighbours; ++n) {
         const std::int32_t dx = n % 3 - 1, dy = (n / 3) % 3 - 1, dz = D == 3 ? n / 9 - 1 : 0;
         const std::uint32_t b = grid_.bucket(c[0] + dx, c[1] + dy, c[2] + dz);
         // Two neighbouring cells can share a bucket: visit each bucket once.
-        bool repeat = false;
-        for (int k = 0; k < seen_count; ++k) repeat = repeat || seen[k] == b;
-        if (repeat) continue;
+        const std::uint64_t bit = std::uint64_t(1) << (b & 63u);
+        if (seen_bits & bit) {
+          bool repeat = false;
+          for (int k = 0; k < seen_count; ++k) repeat = repeat || seen[k] == b;
+          if (repeat) continue;
+        }
+        seen_bits |= bit;
         seen[seen_count++] = b;
-        for (std::uint32_t k = grid_.start[b]; k < grid_.start[b + 1]; ++k) {
-          const std::uint32_t j = grid_.items[k];
+        const detail::GridItem<D>* it = grid_.items + grid_.start[b];
+        const detail::GridItem<D>* const end = grid_.items + grid_.start[b + 1];
+        for (; it != end; ++it) {
+          const std::uint32_t j = it->body;
           // An awake pair is found once, from its lower index; a sleeper never looks itself.
-          if (j == i || (j < i && bodies_[j].state != MotionState::asleep)) continue;
-          candidate(i, j, found);
+          if (j == i || (j < i && it->awake)) continue;
+          // As `candidate`, from the grid's copy of body j.
+          const Scalar reach = bi.bounding_radius + it->reach;
+          if ((it->position - bi.position).squaredNorm() > reach * reach) continue;
+          if (found < max_pairs_) pairs_[found] = Pair{i < j ? i : j, i < j ? j : i};
+          ++found;
         }
       }
     }
@@ -722,7 +838,12 @@ class WorldCore {
   /// and treats the lower body of each as immovable: whatever approach velocity and overlap are
   /// left go to the upper body alone, so a pile is consistent from the ground up after one pass,
   /// where Gauss-Seidel passes over k layers leave residuals that pump the pile.
-  enum class Pass : std::uint8_t { impact, support, shock };
+  ///
+  /// Position passes repeat only the shock pass's overlap correction. One pass leaves a body
+  /// wedged between several others (or between a sleeper and the ground) where the last push put
+  /// it, which may be back inside the first; a few repetitions let it find the gap, without
+  /// touching velocities.
+  enum class Pass : std::uint8_t { impact, support, shock, position };
 
   /// Plane contacts of every awake body: approaching bodies get the particle response, and a body
   /// inside a plane is moved out along its normal.
@@ -738,11 +859,15 @@ class WorldCore {
         // A support pass also sees a body that the last pass left exactly touching the plane.
         const Scalar slop = pass == Pass::impact ? 0 : b.radius * contact_slop;
         if (!sphere_plane_contact<D>(b.position, b.radius + slop, planes_[p], c)) continue;
-        if (c.depth > slop) b.position += c.normal * (c.depth - slop);
+        if (c.depth > slop) {
+          b.position += c.normal * (c.depth - slop);
+          ++moves_;
+        }
         b.touching = true;
         const bool ground = c.normal[Space<D>::up_axis] >= def_.ground_cosine;
         b.on_ground = b.on_ground || ground;
         ++contacts;
+        if (pass == Pass::position) continue;
         if (pass == Pass::impact && shapes_[b.shape].statistical)
           respond_alone(b, c.normal, Vec::Zero(), ground);
         else
@@ -787,11 +912,14 @@ class WorldCore {
       Scalar imb = b.state == MotionState::asleep ? 0 : b.inv_mass;
       // Shock pass: a contact that mostly supports (normal within 60 degrees of up) freezes its
       // lower body; the normal points from a to b, so n_up > 0 means a is below.
-      if (pass == Pass::shock && n[up] >= Scalar(0.5) && imb > 0) ima = 0;
-      if (pass == Pass::shock && n[up] <= Scalar(-0.5) && ima > 0) imb = 0;
+      const bool bottom_up = pass == Pass::shock || pass == Pass::position;
+      if (bottom_up && n[up] >= Scalar(0.5) && imb > 0) ima = 0;
+      if (bottom_up && n[up] <= Scalar(-0.5) && ima > 0) imb = 0;
       const Scalar ims = ima + imb;
       if (ims <= 0) continue;
-      if (pass == Pass::impact && (shapes_[a.shape].statistical || shapes_[b.shape].statistical)) {
+      if (pass == Pass::position) {
+        // Velocities were settled by the passes before; this pass only moves.
+      } else if (pass == Pass::impact && (shapes_[a.shape].statistical || shapes_[b.shape].statistical)) {
         respond_pair(a, b, n, ima, imb);
       } else {
         particle_response<D>({a.linear_velocity, a.angular_velocity, ima, contact_radius(a)},
@@ -802,12 +930,14 @@ class WorldCore {
       // one. Pushing overlaps apart in every pass, split between both bodies, squeezes bodies
       // sideways and upward out of a packed pile each step, and the lift comes back as kinetic
       // energy, so the pile never sleeps. Split in proportion to inverse mass (in the shock pass
-      // the lower body's is 0), so a sleeper does not move.
-      const bool correct = pass == (def_.shock_propagation ? Pass::shock : Pass::impact);
+      // the lower body's is 0), so a sleeper does not move. The position passes after the shock
+      // pass repeat only this correction, with the same order and the same frozen bodies.
+      const bool correct = pass == (def_.shock_propagation ? Pass::shock : Pass::impact) || pass == Pass::position;
       const Scalar depth = (c.depth - slop - def_.allowed_overlap * (a.radius + b.radius)) * def_.overlap_correction;
       if (correct && depth > 0) {
         a.position -= n * (depth * ima / ims);
         b.position += n * (depth * imb / ims);
+        ++moves_;
       }
       a.touching = true;
       b.touching = true;
@@ -841,8 +971,12 @@ class WorldCore {
     if (!shape.statistical || !def_.rest_conditions || shape.signature.rest.count == 0) return;
     const Scalar step = dt / def_.rest_blend_time;
     if (settling_on_ground) {
-      if (b.rest_pose == no_rest_pose)
-        b.rest_pose = std::uint8_t(nearest_rest_pose<D>(shape.signature, b.orientation, Vec::Unit(Space<D>::up_axis)));
+      if (b.rest_pose == no_rest_pose) {
+        const std::uint32_t pose =
+            nearest_rest_pose<D>(shape.signature, b.orientation, Vec::Unit(Space<D>::up_axis), shape.rest_bias.data());
+        if (pose >= shape.signature.rest.count) return;  // only with a non-finite orientation
+        b.rest_pose = std::uint8_t(pose);
+      }
       b.rest_blend = b.rest_blend + step < 1 ? b.rest_blend + step : Scalar(1);
     } else if (fast && b.rest_pose != no_rest_pose) {
       b.rest_blend = b.rest_blend - step > 0 ? b.rest_blend - step : Scalar(0);
@@ -912,12 +1046,13 @@ class WorldCore {
   Pair* pairs_;
   Plane<D>* planes_;
   Shape<D>* shapes_;
-  detail::SpatialHash grid_;
+  detail::SpatialHash<D> grid_;
   std::uint32_t max_bodies_, max_pairs_, max_planes_, max_shapes_;
   std::uint32_t body_count_ = 0, pair_count_ = 0, plane_count_ = 0, shape_count_ = 0;
   std::uint64_t step_count_ = 0;
   std::uint64_t energy_clamps_ = 0;
   std::uint32_t energy_clamps_step_ = 0;
+  std::uint32_t moves_ = 0;  ///< position corrections in the current pass (step-local)
   WorldDef<D> def_{};
   Status construction_status_ = Status::ok;
 };
@@ -932,7 +1067,7 @@ struct WorldStorage {
   std::array<Plane<D>, MaxPlanes> plane_store;
   std::array<Shape<D>, MaxShapes> shape_store;
   std::array<std::uint32_t, detail::grid_buckets(MaxBodies) + 1> grid_start_store;
-  std::array<std::uint32_t, MaxBodies> grid_item_store;
+  std::array<detail::GridItem<D>, MaxBodies> grid_item_store;
 };
 }  // namespace detail
 
@@ -940,7 +1075,7 @@ struct WorldStorage {
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
 /// `overflow_pairs`)
 /// and `MaxShapes` shapes. All storage is inside the object: a large world belongs in static
-/// storage, not on the stack (10,000 bodies take about 1.5 MB).
+/// storage, not on the stack (10,000 bodies take about 2 MB with the default pair buffer).
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
           std::uint32_t MaxShapes = 8>
 class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>, public WorldCore<D> {

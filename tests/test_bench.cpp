@@ -82,6 +82,10 @@ void check_cells(const BenchResult& r)
     CHECK(c.step_ms_envelope > 0);
     CHECK(c.step_ms_envelope <= c.step_ms_min * (1 + 1e-12));  // the envelope is below every repeat
     CHECK(std::isfinite(c.mean_height_end));
+    CHECK(c.fall_steps >= 0);
+    CHECK(c.fall_steps <= c.steps);
+    CHECK(std::isfinite(c.cpu_ms));
+    CHECK(c.cpu_ms >= 0);  // thread CPU time, read once per repeat
     if (c.engine == "statsim") {
       CHECK(c.collision_ms < 0);  // n/a
     } else {
@@ -239,11 +243,29 @@ TEST_CASE("bench 3D tiny configuration runs every method")
   check_csv(r);
   check_markdown(r);
 
+  // The CSV reads back (what --replot uses).
+  const BenchResult back = bench_from_csv(bench_csv(r));
+  REQUIRE(back.cells.size() == r.cells.size());
+  for (std::size_t i = 0; i < r.cells.size(); ++i) {
+    CHECK(back.cells[i].method == r.cells[i].method);
+    CHECK(back.cells[i].n == r.cells[i].n);
+    CHECK(back.cells[i].broadphase == r.cells[i].broadphase);
+    CHECK(back.cells[i].engine == r.cells[i].engine);
+    CHECK(back.cells[i].step_ms_median == doctest::Approx(r.cells[i].step_ms_median).epsilon(1e-8));
+    CHECK(back.cells[i].cpu_ms == doctest::Approx(r.cells[i].cpu_ms).epsilon(1e-8));
+  }
+
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "statsim_test_bench";
   std::filesystem::create_directories(dir);
   const std::filesystem::path png = dir / "bench.png";
   write_bench_chart(r, png);
   CHECK(std::filesystem::file_size(png) > 1000);
+  // The CPU-time chart, from the read-back CSV (what --replot --chart-cpu draws).
+  BenchResult cpu = back;
+  cpu.options.chart_cpu = true;
+  const std::filesystem::path png_cpu = dir / "bench_cpu.png";
+  write_bench_chart(cpu, png_cpu);
+  CHECK(std::filesystem::file_size(png_cpu) > 1000);
   std::filesystem::remove_all(dir);
 }
 

@@ -123,7 +123,7 @@ TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skip
 {
   // Collision spheres are tiny, so no contact moves a body and the end-of-step positions are the
   // positions the broad phase saw.
-  for (BroadPhase bp : {BroadPhase::grid, BroadPhase::sweep_and_prune}) {
+  for (BroadPhase bp : {BroadPhase::grid, BroadPhase::sweep_and_prune, BroadPhase::automatic}) {
   CAPTURE(int(bp));
   WorldDef3 def;
   def.gravity = Vector3::Zero();
@@ -161,6 +161,44 @@ TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skip
     REQUIRE(r.pairs_found == want.size());
   }
   }
+}
+
+namespace {
+
+// A pile in which contacts move bodies: the order pairs are found in shapes the result, so equal
+// bits mean the same broad phase ran.
+std::uint64_t pile_hash(BroadPhase bp, std::uint32_t grid_above, std::uint32_t bodies)
+{
+  WorldDef2 def;
+  def.broad_phase = bp;
+  def.grid_above_bodies = grid_above;
+  auto world = std::make_unique<World2<200>>(def);
+  ShapeDef disc;
+  disc.radius = 0.3f;
+  disc.bounding_radius = 0.3f;
+  const ShapeId shape = world->add_shape(disc).id;
+  REQUIRE(world->add_plane(Vector2(0, 1), 0).ok());
+  Pcg32 rng(5, 0);
+  for (std::uint32_t i = 0; i < bodies; ++i) {
+    BodyDef2 b;
+    b.shape = shape;
+    b.position = Vector2(rng.uniform(-2, 2), rng.uniform(0.3f, 8));
+    REQUIRE(world->add_body(b).ok());
+  }
+  for (int step = 0; step < 200; ++step) REQUIRE(world->step(1.0f / 60).ok());
+  return world->state_hash();
+}
+
+}  // namespace
+
+TEST_CASE("automatic broad phase: sweep-and-prune up to the threshold and the grid above it")
+{
+  const std::uint64_t sap = pile_hash(BroadPhase::sweep_and_prune, 2048, 120);
+  const std::uint64_t grid = pile_hash(BroadPhase::grid, 2048, 120);
+  REQUIRE(sap != grid);  // else this scene could not tell them apart
+  CHECK(pile_hash(BroadPhase::automatic, 120, 120) == sap);   // 120 bodies, not above 120
+  CHECK(pile_hash(BroadPhase::automatic, 119, 120) == grid);  // above 119: the grid
+  CHECK(WorldDef3{}.broad_phase == BroadPhase::automatic);
 }
 
 TEST_CASE("pair buffer overflow is reported with the number dropped")

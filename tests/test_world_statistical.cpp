@@ -4,9 +4,13 @@
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
+#include "tables/box.hpp"
+#include "tables/bunny.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 
 using namespace statsim;
 using statsim::testing::cube_synthetic;
@@ -89,6 +93,175 @@ TEST_CASE("statistical cubes rest on a face at half the side - with resting cond
     if (rest) CHECK(face_down == 20);
     else CHECK(face_down < 20);  // without resting conditions bodies stop in arbitrary poses
   }
+}
+
+namespace {
+/// A uniformly random orientation: a normalised 4D Gaussian.
+Quaternion random_orientation(Pcg32& g)
+{
+  float a, b, c, d;
+  g.gaussian_pair(a, b);
+  g.gaussian_pair(c, d);
+  return Quaternion(a, b, c, d).normalized();
+}
+
+/// Drops `n` bodies of `shape` from random heights with random orientations and spins, 6 m apart
+/// so that each falls alone (the caller checks that no two ever come near), and steps until all
+/// sleep or 30 simulated seconds pass.
+void drop_apart(WorldCore3& w, ShapeId shape, int n, std::uint64_t seed)
+{
+  Pcg32 g(seed, 3);
+  for (int i = 0; i < n; ++i) {
+    BodyDef3 b;
+    b.shape = shape;
+    const float z = g.uniform(0.3f, 1.5f);
+    b.position = Vector3(6.0f * float(i % 32), 6.0f * float(i / 32), z);
+    b.orientation = random_orientation(g);
+    const float wx = g.uniform(-10, 10), wy = g.uniform(-10, 10), wz = g.uniform(-10, 10);
+    b.angular_velocity = Vector3(wx, wy, wz);
+    REQUIRE(w.add_body(b).ok());
+  }
+  for (int s = 0; s < 60 * 30 && w.count(MotionState::asleep) < w.body_count(); ++s) {
+    REQUIRE(w.step(1.0f / 60).ok());
+    REQUIRE(w.pair_count() == 0);  // independent drops: no two bounding spheres ever overlap
+  }
+}
+
+/// Angle between a body's nearest rest pose (by angle alone) and up, in degrees.
+float degrees_from_rest(const SignatureView<3>& sig, const Body3& b)
+{
+  const std::uint32_t p = nearest_rest_pose<3>(sig, b.orientation, Vector3(0, 0, 1));
+  const float c = (b.orientation * sig.rest.normal(p)).z();
+  return std::acos(std::min(1.0f, c)) * 57.2957795f;
+}
+}  // namespace
+
+TEST_CASE("1000 single bunny drops end in the table's rest poses - total variation at most 0.10")
+{
+  const SignatureView<3> sig = tables::bunny.view();
+  auto w = std::make_unique<World3<1000>>();
+  const ShapeId bunny = w->add_shape(sig).id;
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+  drop_apart(*w, bunny, 1000, 5);
+  REQUIRE(w->count(MotionState::asleep) == 1000);
+  std::uint32_t hits[max_rest_poses] = {};
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+    REQUIRE(w->body(i).rest_pose < sig.rest.count);
+    ++hits[w->body(i).rest_pose];
+  }
+  // The table keeps poses seen in more than 5% of its drops; its frequencies are compared as
+  // shares of the kept ones.
+  float total = 0, tv = 0;
+  for (std::uint32_t p = 0; p < sig.rest.count; ++p) total += sig.rest.frequencies[p];
+  for (std::uint32_t p = 0; p < sig.rest.count; ++p) {
+    const float share = float(hits[p]) / 1000, expected = sig.rest.frequencies[p] / total;
+    MESSAGE("pose " << p << ": " << share << " (table " << expected << ")");
+    tv += std::fabs(share - expected) / 2;
+  }
+  MESSAGE("total variation distance " << tv);
+  CHECK(tv <= 0.10f);
+}
+
+TEST_CASE("bunny resting conditions off vs on - in a pose at h_rest only with them")
+{
+  const SignatureView<3> sig = tables::bunny.view();
+  for (bool rest : {true, false}) {
+    WorldDef3 def;
+    def.rest_conditions = rest;
+    auto w = std::make_unique<World3<100>>(def);
+    const ShapeId bunny = w->add_shape(sig).id;
+    REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+    drop_apart(*w, bunny, 100, 8);
+    CHECK(w->count(MotionState::asleep) == 100);
+    int in_pose = 0, at_height = 0;
+    float worst_angle = 0, worst_height = 0;
+    for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+      const Body3& b = w->body(i);
+      const float angle = degrees_from_rest(sig, b);
+      const std::uint32_t p = nearest_rest_pose<3>(sig, b.orientation, Vector3(0, 0, 1));
+      const float height = std::fabs(b.position.z() - sig.rest.heights[p]) / sig.rest.heights[p];
+      worst_angle = std::max(worst_angle, angle);
+      worst_height = std::max(worst_height, height);
+      in_pose += angle <= 5;
+      at_height += height <= 0.01f;
+    }
+    MESSAGE(std::string(rest ? "with" : "without") << " resting conditions: " << in_pose << " of 100 within 5 degrees of a rest pose (worst "
+                                        << worst_angle << "), " << at_height << " within 1% of its h_rest (worst "
+                                        << 100 * worst_height << "%)");
+    if (rest) {
+      CHECK(in_pose == 100);
+      CHECK(at_height == 100);
+    } else {
+      // Without them a bunny stops in whatever orientation it has, on its collision sphere.
+      CHECK(in_pose < 50);
+      CHECK(at_height == 0);
+    }
+  }
+}
+
+TEST_CASE("cubes with the gathered box table rest face down at half the side")
+{
+  const SignatureView<3> sig = tables::box.view();
+  auto w = std::make_unique<World3<40>>();
+  const ShapeId box = w->add_shape(sig).id;
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+  drop_apart(*w, box, 40, 11);
+  CHECK(w->count(MotionState::asleep) == 40);
+  int poses[6] = {};
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+    const Body3& b = w->body(i);
+    REQUIRE(b.rest_pose < 6);
+    ++poses[b.rest_pose];
+    // Face down: one of the cube's body axes points straight down (within 1 degree), whatever
+    // the table says its poses are.
+    const Eigen::Matrix3f r = b.orientation.toRotationMatrix();
+    float lowest = 0;
+    for (int k = 0; k < 3; ++k) lowest = std::min({lowest, r(2, k), -r(2, k)});
+    CHECK(lowest < -std::cos(0.0175f));
+    CHECK(b.position.z() == doctest::Approx(0.1).epsilon(0.01));  // half the 0.2 m side
+  }
+  int used = 0;
+  for (int p : poses) used += p > 0;
+  CHECK(used >= 5);  // random drops reach (nearly) every face
+}
+
+TEST_CASE("a pile of 600 bunnies holds - sphere overlaps under 10% of the radius and none below the ground")
+{
+  auto w = std::make_unique<World3<600, 8, 12000>>();  // a deep pile has up to 8 candidate pairs per body
+  const ShapeId bunny = w->add_shape(tables::bunny.view()).id;
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+  Pcg32 g(1, 0);
+  // A column 0.8 m in radius, 10 m high: the pile is several bodies deep in the middle.
+  for (int i = 0; i < 600; ++i) {
+    BodyDef3 b;
+    b.shape = bunny;
+    const float x = g.uniform(-0.8f, 0.8f), y = g.uniform(-0.8f, 0.8f);
+    if (x * x + y * y > 0.64f) {
+      --i;
+      continue;
+    }
+    const float z = 0.3f + float(i) / 60;
+    b.position = Vector3(x, y, z);
+    b.orientation = random_orientation(g);
+    const float wx = g.uniform(-5, 5), wy = g.uniform(-5, 5), wz = g.uniform(-5, 5);
+    b.angular_velocity = Vector3(wx, wy, wz);
+    REQUIRE(w->add_body(b).ok());
+  }
+  for (int s = 0; s < 60 * 20 && w->count(MotionState::asleep) < w->body_count(); ++s) REQUIRE(w->step(1.0f / 60).ok());
+  CHECK(w->count(MotionState::asleep) >= 540);
+  float deepest = 0, lowest = 1;
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+    const Body3& a = w->body(i);
+    lowest = std::min(lowest, a.position.z() - a.radius);
+    for (std::uint32_t j = i + 1; j < w->body_count(); ++j) {
+      const Body3& b = w->body(j);
+      const float gap = (a.position - b.position).norm() - a.radius - b.radius;
+      if (gap < 0) deepest = std::max(deepest, -gap / std::min(a.radius, b.radius));
+    }
+  }
+  MESSAGE("asleep " << w->count(MotionState::asleep) << ", deepest overlap " << 100 * deepest << "% of the radius, lowest sphere bottom " << lowest << " m");
+  CHECK(deepest < 0.10f);
+  CHECK(lowest > -0.001f);
 }
 
 TEST_CASE("statistical bodies never end a step below the ground - at any speed up to 50 m/s")

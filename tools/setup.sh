@@ -20,6 +20,12 @@ if [ "$minimal" = 0 ]; then
   # Tests (doctest), host tools (reference engines, command line, JSON, images, meshes).
   packages+=(doctest-dev libbox2d-dev libbullet-dev libcli11-dev nlohmann-json3-dev
              libstb-dev libmeshoptimizer-dev libtinyobjloader-dev)
+  # The firmware example and its test: Cortex-M toolchain, C and C++ libraries, and the emulator.
+  packages+=(gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm)
+  # Pictures: glTF export (tinygltf), GIF writing (giflib) and optimising (gifsicle).
+  packages+=(libtinygltf-dev libgif-dev gifsicle)
+  # Fuzzing (tests/fuzz, STATSIM_FUZZ=ON): clang with libFuzzer and the sanitizer runtimes.
+  packages+=(clang-14 libclang-rt-14-dev)
 fi
 
 missing=()

@@ -154,8 +154,11 @@ std::vector<std::string> default_methods(int dim)
 {
   std::vector<std::string> m = dim == 2 ? std::vector<std::string>{"polygon", "circle", "statistical"}
                                         : std::vector<std::string>{"full", "low", "spheres7", "sphere", "statistical"};
-  if (statsim_has_broad_phase_switch())
-    m.push_back(statsim_default_broad_phase() == "grid" ? "statistical-sap" : "statistical-grid");
+  if (statsim_has_broad_phase_switch()) {
+    const std::string d = statsim_default_broad_phase();
+    if (d != "grid") m.push_back("statistical-grid");
+    if (d != "sap") m.push_back("statistical-sap");
+  }
   return m;
 }
 
@@ -178,8 +181,7 @@ double median(std::vector<double> v)
 struct RepeatStats {
   std::vector<double> step_ms;  // every step's time
   double whole_ms = 0;
-  double fall_ms = std::numeric_limits<double>::quiet_NaN();
-  double settle_ms = std::numeric_limits<double>::quiet_NaN();
+  double cpu_ms = 0;  // thread CPU time per step over the run
   double collision_ms = -1, broad_ms = -1, narrow_ms = -1;
   int first_sleep = -1;
 };
@@ -416,8 +418,15 @@ private:
         run_repeat(c, i, r, &s3, &s2);
       }
 
+    // The falling window: steps before the first body of any method fell asleep (sleeping
+    // flatters every engine, each in its own way, so the phase is cut at the same step for all).
+    int fall_steps = o_.steps;
+    for (const CellState& c : cells)
+      if (!c.cell.skipped)
+        for (const RepeatStats& r : c.repeats)
+          if (r.first_sleep > 0) fall_steps = std::min(fall_steps, r.first_sleep);
     for (CellState& c : cells) {
-      finish(c);
+      finish(c, fall_steps);
       if (!c.cell.skipped) last_measured_[c.cell.method + "/" + c.cell.broadphase] = {n, c.cell.step_ms_median};
       result.cells.push_back(c.cell);
     }
@@ -445,6 +454,7 @@ private:
     Clock::time_point last_report = start;
     double window = 0;  // sum of the last 10 step times, ms
     double running = 0;  // sum of all step times so far, ms
+    const double cpu0 = thread_cpu_ms();
     for (int s = 0; s < steps; ++s) {
       const Clock::time_point t0 = Clock::now();
       sim->step();
@@ -473,22 +483,12 @@ private:
       }
     }
     RepeatStats st;
+    st.cpu_ms = (thread_cpu_ms() - cpu0) / steps;
     st.step_ms = total;
     double sum = 0;
     for (double t : total) sum += t;
     st.whole_ms = sum / steps;
     st.first_sleep = first_sleep;
-    const int split = first_sleep < 0 ? steps : first_sleep;
-    if (split > 0) {
-      double f = 0;
-      for (int s = 0; s < split; ++s) f += total[static_cast<std::size_t>(s)];
-      st.fall_ms = f / split;
-    }
-    if (split < steps) {
-      double f = 0;
-      for (int s = split; s < steps; ++s) f += total[static_cast<std::size_t>(s)];
-      st.settle_ms = f / (steps - split);
-    }
     if (have_phases) {
       double a = 0, b = 0, cc = 0;
       for (int s = 0; s < steps; ++s) {
@@ -515,12 +515,14 @@ private:
     const std::string w = sim->warning();
     if (!w.empty()) c.warning = c.warning.empty() ? w : c.warning + "; " + w;
     if (o_.progress)
-      std::fprintf(stderr, "  %-11s %-4s N=%-6d repeat %d/%d: %10.4f ms/step (falling %s, first sleep at step %d)\n",
-                   k.method.c_str(), k.broadphase.c_str(), c.cell.n, r + 1, o_.repeats, st.whole_ms,
-                   std::isnan(st.fall_ms) ? "n/a" : fmt("%.4f ms", st.fall_ms).c_str(), first_sleep);
+      std::fprintf(stderr, "  %-11s %-4s N=%-6d repeat %d/%d: %10.4f ms/step, CPU %10.4f ms/step (first sleep at step %d)\n",
+                   k.method.c_str(), k.broadphase.c_str(), c.cell.n, r + 1, o_.repeats, st.whole_ms, st.cpu_ms,
+                   first_sleep);
   }
 
-  void finish(CellState& c) const
+  /// `fall_steps`: the falling window common to every method at this N (steps before the first
+  /// body of any method falls asleep).
+  void finish(CellState& c, int fall_steps) const
   {
     BenchCell& b = c.cell;
     if (!c.warning.empty()) b.note = b.note.empty() ? c.warning : b.note + "; " + c.warning;
@@ -529,11 +531,16 @@ private:
       b.repeats = 0;
       return;
     }
-    std::vector<double> whole, fall, settle, coll, resp, broad, narrow, sleep;
+    std::vector<double> whole, fall, settle, coll, resp, broad, narrow, sleep, cpu;
+    b.fall_steps = fall_steps;
     for (const RepeatStats& r : c.repeats) {
       whole.push_back(r.whole_ms);
-      if (!std::isnan(r.fall_ms)) fall.push_back(r.fall_ms);
-      if (!std::isnan(r.settle_ms)) settle.push_back(r.settle_ms);
+      cpu.push_back(r.cpu_ms);
+      const std::size_t k = r.step_ms.size(), f = std::min<std::size_t>(static_cast<std::size_t>(fall_steps), k);
+      double a = 0, z = 0;
+      for (std::size_t s = 0; s < k; ++s) (s < f ? a : z) += r.step_ms[s];
+      if (f > 0) fall.push_back(a / static_cast<double>(f));
+      if (f < k) settle.push_back(z / static_cast<double>(k - f));
       if (r.collision_ms >= 0) {
         coll.push_back(r.collision_ms);
         resp.push_back(r.whole_ms - r.collision_ms);
@@ -557,6 +564,7 @@ private:
       b.step_ms_envelope = sum / static_cast<double>(k);
     }
     b.step_ms_median = median(whole);
+    b.cpu_ms = median(cpu);
     b.step_ms_min = *std::min_element(whole.begin(), whole.end());
     b.step_ms_max = *std::max_element(whole.begin(), whole.end());
     if (!fall.empty()) b.fall_ms = median(fall);

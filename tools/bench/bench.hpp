@@ -7,7 +7,8 @@
 //   hull        Bullet, btConvexHullShape of bunny_low.obj's vertices (what a game would use)
 //   spheres7    Bullet, btCompoundShape of the 7 spheres of bunny_spheres7.txt
 //   sphere      Bullet, one btSphereShape (radius: the table's mean collision radius at zero spin)
-//   statistical statsim World3 with the shape's table, its sweep-and-prune
+//   statistical statsim World3 with the shape's table and the runtime's default broad phase (the
+//               hashed grid); statistical-sap and statistical-grid force one of its two
 // 2D (--dim 2, squares): polygon (Box2D b2PolygonShape), circle (Box2D b2CircleShape), statistical
 // (statsim World2 with the square2d table).
 //
@@ -15,8 +16,9 @@
 // then thrown away, then `repeats` timed runs of `steps` steps, each in a fresh world built from the
 // initial states (construction is not timed). Repeats are interleaved across methods (repeat 1 of
 // every method, then repeat 2, ...) so that load drifting on a shared machine hits all methods
-// alike. Per repeat: mean time per step over the whole run, over the falling phase (steps before
-// the first body falls asleep) and over the rest; reported: the median over repeats, the min and
+// alike. Per repeat: mean time per step over the whole run, over the falling phase (the steps
+// before the first body of any method at that N falls asleep: the same window for all) and over
+// the rest; reported: the median over repeats, the min and
 // max of the whole-run means, and the envelope: the mean over steps of the fastest repeat at each
 // step (the engines are deterministic, so every repeat does the same work step by step, and the
 // envelope filters out preemption on a loaded machine).
@@ -53,6 +55,7 @@ struct BenchOptions {
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes
   bool allow_synthetic = false;      ///< use the synthetic cube / square signature if a table is missing
   bool progress = true;              ///< progress lines on stderr
+  bool chart_cpu = false;            ///< chart the thread CPU time instead of the wall-clock median
 };
 
 /// One cell of the benchmark: a method at one N with one broad phase.
@@ -69,11 +72,18 @@ struct BenchCell {
   /// Whole run, per step: the mean over steps of the fastest repeat at each step (the repeats
   /// are identical simulations, so this filters out preemption by other processes).
   double step_ms_envelope = 0;
+  /// Whole run, per step: this thread's CPU time (not time waiting for a core on a shared
+  /// machine; it includes the bench loop's own bookkeeping, a few microseconds per step at most),
+  /// median over repeats.
+  double cpu_ms = -1;
   double collision_ms = -1, response_ms = -1;  ///< per step, median over repeats; -1: n/a
   double broad_ms = -1, narrow_ms = -1;        ///< per step; -1: n/a
-  double fall_ms = -1;     ///< per step before the first body sleeps (median over repeats); -1: none
-  double settle_ms = -1;   ///< per step from the first sleeping body on; -1: nobody slept
-  int first_sleep_step = -1;  ///< median over repeats; -1: nobody slept within the run
+  /// Falling phase: steps 1..fall_steps, before the first body of any method at this N fell
+  /// asleep (the same window for every method). Per step, median over repeats; -1: empty window.
+  double fall_ms = -1;
+  double settle_ms = -1;   ///< per step after the falling window; -1: the window is the whole run
+  int fall_steps = 0;      ///< length of the falling window, steps
+  int first_sleep_step = -1;  ///< this method's first step ending with a body asleep (median); -1: none
   double asleep_end = 0;      ///< fraction of bodies asleep at the end of the last repeat
   double mean_height_end = 0; ///< m
   double contacts_end = 0;    ///< touching pairs at the end, per body
@@ -96,11 +106,14 @@ BenchResult run_bench(const BenchOptions& options);
 /// split, ratios of statistical to the others, and the settings.
 std::string bench_markdown(const BenchResult& result);
 /// CSV, one row per cell: method,n,broadphase,step_ms_median,step_ms_min,step_ms_max,collision_ms,
-/// response_ms,broad_ms,narrow_ms,fall_ms,settle_ms,first_sleep_step,step_ms_envelope,repeats,steps,
+/// response_ms,broad_ms,narrow_ms,fall_ms,settle_ms,fall_steps,first_sleep_step,step_ms_envelope,cpu_ms,repeats,steps,
 /// engine,skipped,asleep_end,mean_height_end,contacts_per_body_end,note. n/a values are empty.
 std::string bench_csv(const BenchResult& result);
 /// Log-log chart of time per step against N, one line per method and broad phase.
 void write_bench_chart(const BenchResult& result, const std::filesystem::path& path);
+/// The cells of a CSV written by bench_csv() (enough for write_bench_chart: method, n, broadphase,
+/// engine, skipped, step_ms_median; the shape is not in the CSV). Throws std::invalid_argument.
+BenchResult bench_from_csv(const std::string& csv);
 
 /// Adds `statsim bench`.
 void register_bench_commands(CLI::App& app);

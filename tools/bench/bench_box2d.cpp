@@ -5,6 +5,7 @@
 
 #include <box2d/box2d.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -25,9 +26,11 @@ public:
     world_ = std::make_unique<b2World>(b2Vec2(0.0f, -9.81f));
     b2BodyDef gd;
     b2Body* ground = world_->CreateBody(&gd);
+    // The ground reaches far beyond the scene: Box2D's circles roll without resistance and would
+    // otherwise roll off its ends.
+    const float reach = static_cast<float>(std::max(1000.0, 20 * scene.bounds_hi.x()));
     b2EdgeShape edge;
-    edge.SetTwoSided(b2Vec2(static_cast<float>(scene.bounds_lo.x()), 0.0f),
-                     b2Vec2(static_cast<float>(scene.bounds_hi.x()), 0.0f));
+    edge.SetTwoSided(b2Vec2(-reach, 0.0f), b2Vec2(reach, 0.0f));
     b2FixtureDef gf;
     gf.shape = &edge;
     gf.friction = static_cast<float>(body.surface.friction);
@@ -124,7 +127,7 @@ std::vector<std::string> box2d_settings(const Body2& body)
   s.push_back(fmt("Box2D shapes: polygon = b2PolygonShape box of side %.3g m (skin 0.01 m, b2_polygonRadius); ",
                   2 * body.half_side) +
               fmt("circle = b2CircleShape of radius %.4g m, ", body.circle_radius) + body.circle_radius_note +
-              "; ground: two-sided b2EdgeShape y = 0");
+              "; ground: two-sided b2EdgeShape y = 0 from x = -max(1000 m, 20 x the scene's reach) to +");
   s.push_back(fmt("Box2D material: friction %.3g ", body.surface.friction) +
               fmt("(Box2D mixes sqrt(a b)), restitution %.3g (mixes max), ", body.surface.restitution) +
               fmt("restitution threshold %.3g m/s (default 1)", body.surface.restitution_threshold));

@@ -10,7 +10,9 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -22,6 +24,7 @@ struct BenchCommand {
   std::string dt = "1/60";
   std::string csv;
   std::string chart;
+  std::string replot;
   bool quiet = false;
 };
 
@@ -50,6 +53,21 @@ void make_parent(const std::string& file)
 void run_bench_command(BenchCommand& cmd)
 {
   try {
+    if (!cmd.replot.empty()) {
+      // Redraw the chart of an earlier run from its CSV, without running anything.
+      if (cmd.chart.empty()) throw std::invalid_argument("--replot needs --chart FILE.png");
+      std::ifstream in(cmd.replot, std::ios::binary);
+      if (!in) throw std::runtime_error(cmd.replot + ": cannot open file");
+      std::ostringstream text;
+      text << in.rdbuf();
+      BenchResult r = bench_from_csv(text.str());
+      r.options.shape = cmd.options.dim == 2 && cmd.options.shape == "bunny" ? "square" : cmd.options.shape;
+      r.options.chart_cpu = cmd.options.chart_cpu;
+      make_parent(cmd.chart);
+      write_bench_chart(r, cmd.chart);
+      std::printf("wrote %s\n", cmd.chart.c_str());
+      return;
+    }
     cmd.options.dt = parse_dt(cmd.dt);
     cmd.options.progress = !cmd.quiet;
     if (cmd.options.dim == 2 && cmd.options.shape == "bunny") cmd.options.shape = "square";
@@ -108,7 +126,10 @@ void register_bench_commands(CLI::App& app)
               "Time the synthetic test signature when the shape's table is not generated yet (indicative only)");
   b->add_option("--csv", cmd->csv, "Write the CSV here");
   b->add_option("--chart", cmd->chart, "Write the log-log PNG chart here");
+  b->add_option("--replot", cmd->replot, "Only redraw --chart from the CSV of an earlier run (pass its --shape)");
   b->add_flag("--quiet", cmd->quiet, "No progress on stderr");
+  b->add_flag("--chart-cpu", cmd->options.chart_cpu,
+              "Chart the thread CPU time per step instead of the wall-clock median (a machine shared with other work)");
   b->callback([cmd]() { run_bench_command(*cmd); });
 }
 

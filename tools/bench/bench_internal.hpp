@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <chrono>
+#include <ctime>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -20,6 +21,16 @@ using Clock = std::chrono::steady_clock;
 inline std::int64_t elapsed_ns(Clock::time_point a, Clock::time_point b)
 {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(b - a).count();
+}
+
+/// CPU time this thread has used, ms (CLOCK_THREAD_CPUTIME_ID): on a shared machine it leaves out
+/// the time spent waiting for a core. Read once per repeat: each read is a system call (about
+/// 1.3 us here), too slow to bracket single steps of a few microseconds.
+inline double thread_cpu_ms()
+{
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
 }
 
 /// Phase times of the last step, ns; negative when the engine does not report them.

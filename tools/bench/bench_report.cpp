@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -142,9 +143,11 @@ std::string bench_markdown(const BenchResult& r)
        " repeats (each in a fresh world, after " + std::to_string(o.warmup) +
        " warm-up steps in a discarded one; repeats interleaved across methods). *envelope*: the mean over steps of "
        "the fastest repeat at each step (the repeats are identical simulations; this filters out preemption on a "
-       "loaded machine). *collision* = broad + narrow "
-       "phase, *response* = the rest of the step; statsim does not expose phase times (n/a). *falling* = steps "
-       "before the first body falls asleep, *settling* = the steps after. Percentages: of `" +
+       "loaded machine). *CPU time*: the thread's CPU time over the run per step (leaves out time spent waiting for "
+       "a core; read once per repeat). *collision* = broad + narrow "
+       "phase, *response* = the rest of the step; statsim does not expose phase times (n/a). *falling* = the steps "
+       "before the first body of any method falls asleep at that N (the same window for every method: sleeping "
+       "flatters each engine differently), *settling* = the steps after. Percentages: of `" +
        reference_method(r) + "` at the same N" + (o.dim == 3 ? " (of `spheres7` where `full` was skipped, marked +)" : "") +
        ".\n\n";
 
@@ -167,13 +170,20 @@ std::string bench_markdown(const BenchResult& r)
       };
       const Row rows[] = {{"one step", &BenchCell::step_ms_median},
                           {"one step, envelope", &BenchCell::step_ms_envelope},
+                          {"one step, CPU time", &BenchCell::cpu_ms},
                           {"collision", &BenchCell::collision_ms},
                           {"response", &BenchCell::response_ms},
                           {"falling", &BenchCell::fall_ms},
                           {"settling", &BenchCell::settle_ms}};
+      int fall_steps = 0;
+      for (const BenchCell& c : r.cells)
+        if (c.n == n && !c.skipped) fall_steps = c.fall_steps;
       bool first = true;
       for (const Row& row : rows) {
-        s += "| " + (first ? std::to_string(n) : std::string()) + " | " + row.name + (alt ? " +" : "") + " |";
+        std::string name = row.name;
+        if (name == "falling") name += " (steps 1-" + std::to_string(fall_steps) + ")";
+        if (name == "settling") name += " (steps " + std::to_string(fall_steps + 1) + "-" + std::to_string(o.steps) + ")";
+        s += "| " + (first ? std::to_string(n) : std::string()) + " | " + name + (alt ? " +" : "") + " |";
         first = false;
         for (const auto& m : methods) {
           const BenchCell* c = find(r, m, bp, n);
@@ -201,7 +211,8 @@ std::string bench_markdown(const BenchResult& r)
   const Metric metrics[] = {
       {"one step, median of repeats", &BenchCell::step_ms_median},
       {"one step, envelope (fastest repeat at each step)", &BenchCell::step_ms_envelope},
-      {"falling phase, median of repeats", &BenchCell::fall_ms},
+      {"one step, thread CPU time, median of repeats", &BenchCell::cpu_ms},
+      {"falling phase (before anything sleeps), median of repeats", &BenchCell::fall_ms},
   };
   for (const Metric& metric : metrics) {
     s += std::string("## Speed-up of statistical: ") + metric.title + " (other method's time / statistical's)\n\n| N |";
@@ -237,9 +248,9 @@ std::string bench_markdown(const BenchResult& r)
     const BenchCell* c = measured(r, m, bp, n);
     const BenchCell* st = measured(r, "statistical", "sap", n);
     if (!c || !st) return "";
-    return ", envelope " + ratio(c->step_ms_envelope, st->step_ms_envelope);
+    return ", envelope " + ratio(c->step_ms_envelope, st->step_ms_envelope) + ", CPU " + ratio(c->cpu_ms, st->cpu_ms);
   };
-  s += "Ratios of medians (Bullet with btAxisSweep3); envelope ratios after them.\n\n";
+  s += "Ratios of medians (Bullet with btAxisSweep3); envelope and CPU-time ratios after them.\n\n";
   auto verdict = [](bool ok) { return ok ? std::string("met") : std::string("NOT met"); };
   if (o.dim == 3) {
     const std::string bp = "sap";
@@ -270,14 +281,15 @@ std::string bench_markdown(const BenchResult& r)
     const BenchCell* s1k = measured(r, "statistical", "sap", 1000);
     s += "- 10,000 bodies, median step <= 5 ms: " +
          (s10k ? ms(s10k->step_ms_median) + " ms (" + verdict(s10k->step_ms_median <= 5) + "; envelope " +
-                     ms(s10k->step_ms_envelope) + " ms)"
+                     ms(s10k->step_ms_envelope) + " ms, CPU " + ms(s10k->cpu_ms) + " ms)"
                : std::string("not measured")) +
          "\n";
     if (s10k && s1k) {
       const double growth = (s10k->step_ms_median / 10000) / (s1k->step_ms_median / 1000);
       const double growth_e = (s10k->step_ms_envelope / 10000) / (s1k->step_ms_envelope / 1000);
+      const double growth_c = (s10k->cpu_ms / 10000) / (s1k->cpu_ms / 1000);
       s += "- time per body from N = 1,000 to 10,000 grows <= 1.5x: " + fmt("%.2fx", growth) + " (" +
-           verdict(growth <= 1.5) + "; envelope " + fmt("%.2fx", growth_e) + ")\n";
+           verdict(growth <= 1.5) + "; envelope " + fmt("%.2fx", growth_e) + ", CPU " + fmt("%.2fx", growth_c) + ")\n";
     } else {
       s += "- time per body from N = 1,000 to 10,000 grows <= 1.5x: not measured\n";
     }
@@ -321,7 +333,7 @@ std::string bench_csv(const BenchResult& r)
   };
   std::string s =
       "method,n,broadphase,step_ms_median,step_ms_min,step_ms_max,collision_ms,response_ms,broad_ms,narrow_ms,"
-      "fall_ms,settle_ms,first_sleep_step,step_ms_envelope,repeats,steps,engine,skipped,asleep_end,mean_height_end,"
+      "fall_ms,settle_ms,fall_steps,first_sleep_step,step_ms_envelope,cpu_ms,repeats,steps,engine,skipped,asleep_end,mean_height_end,"
       "contacts_per_body_end,note\n";
   for (const BenchCell& c : r.cells) {
     const bool m = !c.skipped;
@@ -331,8 +343,9 @@ std::string bench_csv(const BenchResult& r)
     s += (m ? num(c.collision_ms) : "") + "," + (m ? num(c.response_ms) : "") + "," + (m ? num(c.broad_ms) : "") + "," +
          (m ? num(c.narrow_ms) : "") + ",";
     s += (m ? num(c.fall_ms) : "") + "," + (m ? num(c.settle_ms) : "") + "," +
+         (m ? std::to_string(c.fall_steps) : std::string()) + "," +
          (m && c.first_sleep_step >= 0 ? std::to_string(c.first_sleep_step) : std::string()) + "," +
-         (m ? num(c.step_ms_envelope) : "") + ",";
+         (m ? num(c.step_ms_envelope) : "") + "," + (m ? num(c.cpu_ms) : "") + ",";
     s += std::to_string(c.repeats) + "," + std::to_string(c.steps) + "," + c.engine + "," + (c.skipped ? "1" : "0") +
          ",";
     s += (m ? num(c.asleep_end) : "") + "," + (m ? num(c.mean_height_end) : "") + "," + (m ? num(c.contacts_end) : "") +
@@ -341,15 +354,92 @@ std::string bench_csv(const BenchResult& r)
   return s;
 }
 
+BenchResult bench_from_csv(const std::string& text)
+{
+  auto fields = [](const std::string& line) {
+    std::vector<std::string> out(1);
+    bool quoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      const char c = line[i];
+      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = !quoted;
+      } else if (c == ',' && !quoted) {
+        out.emplace_back();
+      } else if (c != '\r') {
+        out.back() += c;
+      }
+    }
+    return out;
+  };
+  std::vector<std::string> lines;
+  {
+    std::string line;
+    for (char ch : text) {
+      if (ch == '\n') {
+        lines.push_back(line);
+        line.clear();
+      } else {
+        line += ch;
+      }
+    }
+    if (!line.empty()) lines.push_back(line);
+  }
+  if (lines.empty()) throw std::invalid_argument("bench CSV: empty");
+  const std::vector<std::string> header = fields(lines[0]);
+  auto column = [&](const char* name) {
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return i;
+    throw std::invalid_argument(std::string("bench CSV: no column ") + name);
+  };
+  const std::size_t cm = column("method"), cn = column("n"), cb = column("broadphase"),
+                    cs = column("step_ms_median"), ce = column("engine"), ck = column("skipped");
+  // Optional: CSVs written before the column existed lack it.
+  std::size_t cc = header.size();
+  for (std::size_t i = 0; i < header.size(); ++i)
+    if (header[i] == "cpu_ms") cc = i;
+  BenchResult r;
+  for (std::size_t k = 1; k < lines.size(); ++k) {
+    if (lines[k].empty()) continue;
+    const std::vector<std::string> f = fields(lines[k]);
+    if (f.size() != header.size())
+      throw std::invalid_argument("bench CSV: line " + std::to_string(k + 1) + " has " + std::to_string(f.size()) +
+                                  " fields, the header " + std::to_string(header.size()));
+    BenchCell c;
+    c.method = f[cm];
+    c.n = std::stoi(f[cn]);
+    c.broadphase = f[cb];
+    c.engine = f[ce];
+    c.skipped = f[ck] == "1";
+    if (!c.skipped) c.step_ms_median = std::stod(f[cs]);
+    if (!c.skipped && cc < f.size() && !f[cc].empty()) c.cpu_ms = std::stod(f[cc]);
+    if (c.engine == "box2d") r.options.dim = 2;
+    r.cells.push_back(c);
+  }
+  return r;
+}
+
 void write_bench_chart(const BenchResult& r, const std::filesystem::path& path)
 {
   chart::Chart c;
   c.title = std::string("Time per step vs bodies: ") + r.options.shape + " drop (" +
             (r.options.dim == 3 ? "Bullet vs statsim" : "Box2D vs statsim") + ")";
   c.x = {"bodies N", chart::Scale::log10, std::nullopt, std::nullopt};
-  c.y = {"ms per step (median of repeats)", chart::Scale::log10, std::nullopt, std::nullopt};
+  const bool cpu = r.options.chart_cpu;
+  const auto value = [cpu](const BenchCell& d) { return cpu ? d.cpu_ms : d.step_ms_median; };
+  c.y = {cpu ? "thread CPU ms per step (median of repeats)" : "ms per step (median of repeats)", chart::Scale::log10,
+         std::nullopt, std::nullopt};
   c.width = 1000;
-  c.height = 640;
+  c.height = 680;
+  // A free decade above the data for the legend, top left (the slow methods start high at small
+  // N and climb to the right; the fast ones run along the bottom).
+  double top = 0;
+  for (const BenchCell& cell : r.cells)
+    if (!cell.skipped) top = std::max(top, value(cell));
+  if (top > 0) c.y.max = std::pow(10.0, std::ceil(std::log10(top)) + 1);
+  c.legend = chart::LegendPosition::top_left;
   const chart::Marker markers[] = {chart::Marker::circle, chart::Marker::square, chart::Marker::diamond,
                                    chart::Marker::triangle};
   std::size_t index = 0;
@@ -363,9 +453,9 @@ void write_bench_chart(const BenchResult& r, const std::filesystem::path& path)
     s.name = cell.engine == "bullet" ? cell.method + " (" + cell.broadphase + ")" : cell.method;
     if (cell.engine == "statsim") s.name += " (statsim)";
     for (const BenchCell& d : r.cells)
-      if (d.method == cell.method && d.broadphase == cell.broadphase && !d.skipped) {
+      if (d.method == cell.method && d.broadphase == cell.broadphase && !d.skipped && value(d) > 0) {
         s.x.push_back(d.n);
-        s.y.push_back(d.step_ms_median);
+        s.y.push_back(value(d));
       }
     if (s.x.empty()) continue;
     s.color = chart::palette(colour_of[cell.method]);

@@ -260,7 +260,8 @@ std::string statsim_default_broad_phase()
 {
   if constexpr (HasBroadPhase<WorldDef3>::value) {
     using Kind = decltype(WorldDef3{}.broad_phase);
-    return WorldDef3{}.broad_phase == Kind::grid ? "grid" : "sap";
+    const Kind k = WorldDef3{}.broad_phase;
+    return k == Kind::grid ? "grid" : (k == Kind::sweep_and_prune ? "sap" : "auto");
   } else {
     return "sap";
   }

@@ -2,6 +2,7 @@
 #include "ref2d/compare2d.hpp"
 
 #include "common/atomic_file.hpp"
+#include "common/progress.hpp"
 #include "ref2d/box2d_util.hpp"
 
 #include "statsim/world2.hpp"
@@ -310,6 +311,71 @@ std::vector<Body2State> compare2d_initial_states(const Compare2dOptions& o, doub
   return out;
 }
 
+namespace {
+
+// Pools the per-drop results of one method (each already analysed): step figures are means over
+// the drops, the histogram the mean of equal-sized drops (so the pooled histogram), the final
+// states concatenated; the first drop's step times and sleep steps are kept for display.
+MethodResult pool(const std::vector<MethodResult>& drops)
+{
+  MethodResult p = drops.front();
+  const double k = static_cast<double>(drops.size());
+  p.final.clear();
+  p.asleep = 0;
+  p.median_ms = p.mean_ms = p.falling_median_ms = p.active_mean_ms = 0.0;
+  p.pile_height = p.mean_x = p.mad_x = p.kinetic_energy = p.max_speed = 0.0;
+  p.lowest = std::numeric_limits<double>::infinity();
+  std::fill(p.histogram.begin(), p.histogram.end(), 0.0);
+  for (const MethodResult& d : drops) {
+    p.median_ms += d.median_ms / k;
+    p.mean_ms += d.mean_ms / k;
+    p.falling_median_ms += d.falling_median_ms / k;
+    p.active_mean_ms += d.active_mean_ms / k;
+    p.pile_height += d.pile_height / k;
+    p.mean_x += d.mean_x / k;
+    p.mad_x += d.mad_x / k;
+    p.kinetic_energy += d.kinetic_energy / k;
+    p.max_speed = std::max(p.max_speed, d.max_speed);
+    p.lowest = std::min(p.lowest, d.lowest);
+    p.asleep += d.asleep;
+    p.final.insert(p.final.end(), d.final.begin(), d.final.end());
+    for (std::size_t c = 0; c < p.histogram.size(); ++c) {
+      p.histogram[c] += d.histogram[c] / k;
+    }
+  }
+  return p;
+}
+
+double tvd(const std::vector<double>& a, const std::vector<double>& b)
+{
+  double t = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    t += 0.5 * std::fabs(a[k] - b[k]);
+  }
+  return t;
+}
+
+// 1-Wasserstein distance of two equal-sized samples of x: the mean gap of their order statistics.
+double w1_x(const std::vector<Body2State>& a, const std::vector<Body2State>& b)
+{
+  std::vector<double> xa, xb;
+  for (const Body2State& s : a) {
+    xa.push_back(s.x);
+  }
+  for (const Body2State& s : b) {
+    xb.push_back(s.x);
+  }
+  std::sort(xa.begin(), xa.end());
+  std::sort(xb.begin(), xb.end());
+  double w1 = 0.0;
+  for (std::size_t i = 0; i < xa.size(); ++i) {
+    w1 += std::fabs(xa[i] - xb[i]) / static_cast<double>(xa.size());
+  }
+  return w1;
+}
+
+}  // namespace
+
 Compare2dResult run_compare2d(const Compare2dOptions& o)
 {
   if (o.n < 1 || o.n > kMaxBodies) {
@@ -320,6 +386,9 @@ Compare2dResult run_compare2d(const Compare2dOptions& o)
   }
   if (o.repeat < 1) {
     throw std::invalid_argument("--repeat must be at least 1");
+  }
+  if (o.drops < 1 || o.drops > 1000) {
+    throw std::invalid_argument("--drops must be in 1..1000");
   }
   if (!(o.dt > 0.0 && o.dt <= 0.1)) {
     throw std::invalid_argument("--dt must be in (0, 0.1] s");
@@ -338,35 +407,58 @@ Compare2dResult run_compare2d(const Compare2dOptions& o)
                            "," + fmt("%+.2f", static_cast<double>(sig->rest.normals[2 * k + 1])) + ")");
   }
   r.categories.push_back("other");
-  const std::vector<Body2State> init = compare2d_initial_states(o, shape.bounding_radius);
-  r.box2d = repeated(o.repeat, [&] { return run_box2d_once(o, shape, *sig, init); });
-  r.statsim = repeated(o.repeat, [&] { return run_statsim_once(o, *sig, init); });
-  const int b = r.box2d.first_sleep_step < 0 ? o.steps : r.box2d.first_sleep_step;
-  const int s = r.statsim.first_sleep_step < 0 ? o.steps : r.statsim.first_sleep_step;
-  r.falling_steps = std::max(1, std::min(b, s));
-  const int ba = r.box2d.all_asleep_step < 0 ? o.steps : r.box2d.all_asleep_step + 1;
-  const int sa = r.statsim.all_asleep_step < 0 ? o.steps : r.statsim.all_asleep_step + 1;
-  r.active_steps = std::max(ba, sa);
-  analyse(r.box2d, shape, *sig, r.falling_steps, r.active_steps);
-  analyse(r.statsim, shape, *sig, r.falling_steps, r.active_steps);
-  // Distances of statsim's result from Box2D's.
-  double tvd = 0.0;
-  for (std::size_t k = 0; k < r.box2d.histogram.size(); ++k) {
-    tvd += 0.5 * std::fabs(r.statsim.histogram[k] - r.box2d.histogram[k]);
+  std::vector<MethodResult> box2d, statsim_runs, box2d_b;
+  double falling = 0.0, active = 0.0, tvd_single = 0.0;
+  Progress progress("compare2d", static_cast<std::uint64_t>(2 * o.drops));
+  for (int k = 0; k < o.drops; ++k) {
+    Compare2dOptions ok = o;
+    ok.seed = o.seed + static_cast<std::uint64_t>(k);
+    const std::vector<Body2State> init = compare2d_initial_states(ok, shape.bounding_radius);
+    MethodResult b = repeated(o.repeat, [&] { return run_box2d_once(o, shape, *sig, init); });
+    MethodResult s = repeated(o.repeat, [&] { return run_statsim_once(o, *sig, init); });
+    const int bs = b.first_sleep_step < 0 ? o.steps : b.first_sleep_step;
+    const int ss = s.first_sleep_step < 0 ? o.steps : s.first_sleep_step;
+    const int falling_steps = std::max(1, std::min(bs, ss));
+    const int ba = b.all_asleep_step < 0 ? o.steps : b.all_asleep_step + 1;
+    const int sa = s.all_asleep_step < 0 ? o.steps : s.all_asleep_step + 1;
+    const int active_steps = std::max(ba, sa);
+    analyse(b, shape, *sig, falling_steps, active_steps);
+    analyse(s, shape, *sig, falling_steps, active_steps);
+    falling += falling_steps / static_cast<double>(o.drops);
+    active += active_steps / static_cast<double>(o.drops);
+    tvd_single += tvd(s.histogram, b.histogram) / o.drops;
+    box2d.push_back(std::move(b));
+    statsim_runs.push_back(std::move(s));
+    progress.add();
+    // The second reference sample: the next `drops` seeds, timed once (its times are not shown).
+    ok.seed = o.seed + static_cast<std::uint64_t>(o.drops + k);
+    const std::vector<Body2State> init_b = compare2d_initial_states(ok, shape.bounding_radius);
+    MethodResult bb = run_box2d_once(o, shape, *sig, init_b);
+    const int bbs = bb.first_sleep_step < 0 ? o.steps : bb.first_sleep_step;
+    const int bba = bb.all_asleep_step < 0 ? o.steps : bb.all_asleep_step + 1;
+    analyse(bb, shape, *sig, std::max(1, bbs), bba);
+    bb.method = "box2d_b";
+    box2d_b.push_back(std::move(bb));
+    progress.add();
   }
-  r.statsim.rest_tvd = tvd;
-  std::vector<double> xb, xs;
-  for (std::size_t i = 0; i < init.size(); ++i) {
-    xb.push_back(r.box2d.final[i].x);
-    xs.push_back(r.statsim.final[i].x);
+  progress.finish();
+  r.falling_steps = static_cast<int>(std::lround(falling));
+  r.active_steps = static_cast<int>(std::lround(active));
+  r.box2d = pool(box2d);
+  r.statsim = pool(statsim_runs);
+  r.box2d_b = pool(box2d_b);
+  // Distances from Box2D's pooled result: statsim's, and the noise floor of Box2D's second sample.
+  for (MethodResult* m : {&r.statsim, &r.box2d_b}) {
+    m->rest_tvd = tvd(m->histogram, r.box2d.histogram);
+    const double w1 = w1_x(m->final, r.box2d.final);
+    m->spread_w1 = r.box2d.mad_x > 0.0 ? w1 / r.box2d.mad_x : w1;
   }
-  std::sort(xb.begin(), xb.end());
-  std::sort(xs.begin(), xs.end());
-  double w1 = 0.0;
-  for (std::size_t i = 0; i < xb.size(); ++i) {
-    w1 += std::fabs(xb[i] - xs[i]) / static_cast<double>(xb.size());
+  r.statsim.rest_tvd_single = tvd_single;
+  double tvd_single_b = 0.0;
+  for (int k = 0; k < o.drops; ++k) {
+    tvd_single_b += tvd(box2d_b[static_cast<std::size_t>(k)].histogram, box2d[static_cast<std::size_t>(k)].histogram) / o.drops;
   }
-  r.statsim.spread_w1 = r.box2d.mad_x > 0.0 ? w1 / r.box2d.mad_x : w1;
+  r.box2d_b.rest_tvd_single = tvd_single_b;
   return r;
 }
 
@@ -375,36 +467,44 @@ std::string compare2d_table(const Compare2dResult& r)
   const Compare2dOptions& o = r.options;
   const MethodResult& b = r.box2d;
   const MethodResult& s = r.statsim;
+  const MethodResult& bb = r.box2d_b;
   std::string t;
-  t += "compare2d: " + std::to_string(o.n) + " x " + o.shape + " (table " + r.table + "), " + std::to_string(o.steps) +
-       " steps of " + fmt("%.5g", o.dt) + " s, seed " + std::to_string(o.seed) + "; step times: least of " +
-       std::to_string(o.repeat) + " identical runs\n";
-  t += "                                    box2d      statsim\n";
-  const auto row = [&](const std::string& label, const std::string& x, const std::string& y) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "  %-30s %11s  %11s\n", label.c_str(), x.c_str(), y.c_str());
+  t += "compare2d: " + std::to_string(o.n) + " x " + o.shape + " (table " + r.table + "), " + std::to_string(o.drops) +
+       " drops (seeds " + std::to_string(o.seed) + ".." + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops) - 1) +
+       ") of " + std::to_string(o.steps) + " steps of " + fmt("%.5g", o.dt) +
+       " s; step times: least of " + std::to_string(o.repeat) + " identical runs, mean over the drops\n";
+  t += "box2d_b: Box2D on seeds " + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops)) + ".." +
+       std::to_string(o.seed + static_cast<std::uint64_t>(2 * o.drops) - 1) +
+       ", a second sample of the reference: its distances are the noise floor\n";
+  t += "                                    box2d      statsim      box2d_b\n";
+  const auto row = [&](const std::string& label, const std::string& x, const std::string& y, const std::string& z) {
+    char buf[240];
+    std::snprintf(buf, sizeof buf, "  %-30s %11s  %11s  %11s\n", label.c_str(), x.c_str(), y.c_str(), z.c_str());
     t += buf;
   };
-  row("step time, median (ms)", fmt("%.4f", b.median_ms), fmt("%.4f", s.median_ms));
-  row("step time, mean (ms)", fmt("%.4f", b.mean_ms), fmt("%.4f", s.mean_ms));
-  row("falling: first " + std::to_string(r.falling_steps) + " steps, median", fmt("%.4f", b.falling_median_ms),
-      fmt("%.4f", s.falling_median_ms));
-  row("until all asleep: " + std::to_string(r.active_steps) + " steps, mean", fmt("%.4f", b.active_mean_ms),
-      fmt("%.4f", s.active_mean_ms));
-  row("first step with a sleeper", std::to_string(b.first_sleep_step), std::to_string(s.first_sleep_step));
-  row("all asleep from step", std::to_string(b.all_asleep_step), std::to_string(s.all_asleep_step));
-  row("asleep at the end", std::to_string(b.asleep), std::to_string(s.asleep));
+  row("step time, median (ms)", fmt("%.4f", b.median_ms), fmt("%.4f", s.median_ms), "");
+  row("step time, mean (ms)", fmt("%.4f", b.mean_ms), fmt("%.4f", s.mean_ms), "");
+  row("falling: ~" + std::to_string(r.falling_steps) + " steps, median", fmt("%.4f", b.falling_median_ms),
+      fmt("%.4f", s.falling_median_ms), "");
+  row("until all asleep: ~" + std::to_string(r.active_steps) + " steps, mean", fmt("%.4f", b.active_mean_ms),
+      fmt("%.4f", s.active_mean_ms), "");
+  row("first drop: first sleeper at step", std::to_string(b.first_sleep_step), std::to_string(s.first_sleep_step),
+      std::to_string(bb.first_sleep_step));
+  row("first drop: all asleep from step", std::to_string(b.all_asleep_step), std::to_string(s.all_asleep_step),
+      std::to_string(bb.all_asleep_step));
+  row("asleep at the end, all drops", std::to_string(b.asleep), std::to_string(s.asleep), std::to_string(bb.asleep));
   for (std::size_t k = 0; k < r.categories.size(); ++k) {
-    row("rest " + r.categories[k], fmt("%.3f", b.histogram[k]), fmt("%.3f", s.histogram[k]));
+    row("rest " + r.categories[k], fmt("%.3f", b.histogram[k]), fmt("%.3f", s.histogram[k]), fmt("%.3f", bb.histogram[k]));
   }
-  row("rest-orientation TVD", "0", fmt("%.3f", s.rest_tvd));
-  row("mean x (m)", fmt("%.3f", b.mean_x), fmt("%.3f", s.mean_x));
-  row("mean |x - mean| (m)", fmt("%.3f", b.mad_x), fmt("%.3f", s.mad_x));
-  row("spread W1 / box2d spread", "0", fmt("%.3f", s.spread_w1));
-  row("pile height (m)", fmt("%.3f", b.pile_height), fmt("%.3f", s.pile_height));
-  row("lowest point (m)", fmt("%.4f", b.lowest), fmt("%.4f", s.lowest));
-  row("largest final speed (m/s)", fmt("%.4f", b.max_speed), fmt("%.4f", s.max_speed));
-  row("final kinetic energy (J)", fmt("%.4g", b.kinetic_energy), fmt("%.4g", s.kinetic_energy));
+  row("rest-orientation TVD, pooled", "0", fmt("%.3f", s.rest_tvd), fmt("%.3f", bb.rest_tvd));
+  row("rest TVD per drop, mean", "0", fmt("%.3f", s.rest_tvd_single), fmt("%.3f", bb.rest_tvd_single));
+  row("mean x (m)", fmt("%.3f", b.mean_x), fmt("%.3f", s.mean_x), fmt("%.3f", bb.mean_x));
+  row("mean |x - mean| (m)", fmt("%.3f", b.mad_x), fmt("%.3f", s.mad_x), fmt("%.3f", bb.mad_x));
+  row("spread W1 / box2d spread", "0", fmt("%.3f", s.spread_w1), fmt("%.3f", bb.spread_w1));
+  row("pile height (m)", fmt("%.3f", b.pile_height), fmt("%.3f", s.pile_height), fmt("%.3f", bb.pile_height));
+  row("lowest point (m)", fmt("%.4f", b.lowest), fmt("%.4f", s.lowest), fmt("%.4f", bb.lowest));
+  row("largest final speed (m/s)", fmt("%.4f", b.max_speed), fmt("%.4f", s.max_speed), fmt("%.4f", bb.max_speed));
+  row("final kinetic energy (J)", fmt("%.4g", b.kinetic_energy), fmt("%.4g", s.kinetic_energy), fmt("%.4g", bb.kinetic_energy));
   t += "  speed-up per step: " + fmt("%.1f", b.median_ms / std::max(s.median_ms, 1e-12)) + "x (median), " +
        fmt("%.1f", b.mean_ms / std::max(s.mean_ms, 1e-12)) + "x (mean), " +
        fmt("%.1f", b.falling_median_ms / std::max(s.falling_median_ms, 1e-12)) + "x while falling, " +
@@ -414,12 +514,15 @@ std::string compare2d_table(const Compare2dResult& r)
 
 std::string compare2d_csv(const Compare2dResult& r)
 {
-  std::string s = "method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep\n";
-  for (const MethodResult* m : {&r.box2d, &r.statsim}) {
+  std::string s =
+      "method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep,drops,"
+      "rest_tvd_single\n";
+  for (const MethodResult* m : {&r.box2d, &r.box2d_b, &r.statsim}) {
     s += m->method + "," + std::to_string(r.options.n) + "," + std::to_string(r.options.steps) + "," +
-         fmt("%.6f", m->median_ms) + "," + fmt("%.6f", m->mean_ms) + "," + fmt("%.6f", m->falling_median_ms) + "," + fmt("%.6f", m->active_mean_ms) + "," +
-         fmt("%.6f", m->rest_tvd) + "," + fmt("%.6f", m->spread_w1) + "," + fmt("%.6f", m->pile_height) + "," +
-         std::to_string(m->asleep) + "\n";
+         fmt("%.6f", m->median_ms) + "," + fmt("%.6f", m->mean_ms) + "," + fmt("%.6f", m->falling_median_ms) + "," +
+         fmt("%.6f", m->active_mean_ms) + "," + fmt("%.6f", m->rest_tvd) + "," + fmt("%.6f", m->spread_w1) + "," +
+         fmt("%.6f", m->pile_height) + "," + std::to_string(m->asleep) + "," + std::to_string(r.options.drops) + "," +
+         fmt("%.6f", m->rest_tvd_single) + "\n";
   }
   return s;
 }
@@ -444,6 +547,11 @@ void register_compare2d_command(CLI::App& app)
       ->capture_default_str();
   c->add_option("--seed", cmd->options.seed, "Seed of the initial states")->capture_default_str();
   c->add_option("--repeat", cmd->options.repeat, "Run each simulation this many times; a step's time is the least")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  c->add_option("--drops", cmd->options.drops,
+                 "Independent drops per method (seeds seed, seed+1, ...), pooled; Box2D also runs the next "
+                 "drops seeds as a second reference sample, the noise floor")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   c->add_option("--csv", cmd->csv, "Also write one CSV row per method to this file");

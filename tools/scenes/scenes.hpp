@@ -17,8 +17,9 @@
 //    H = aspect * W, bottom at y0 = s;
 //    so the region's linear size grows as N^(1/3) (N^(1/2) in 2D) and the footprint of the pile
 //    grows more slowly than the number of bodies: they pile up. With the defaults (spacing 1.1,
-//    fill 0.6, aspect 2) and the bunny (R = 0.161 m): N = 10: Rc = 0.71 m, H = 1.42 m;
-//    N = 1,000: Rc = 2.3 m; N = 10,000: Rc = 5.0 m, H = 10 m.
+//    fill 0.6, aspect 2) and the bunny (R = 0.1608 m, s = 0.354 m): Rc = 0.71, 1.06, 2.27, 4.90 m
+//    and H = 1.42, 2.12, 4.55, 9.75 m for N = 10, 100, 1,000, 10,000 (bodies from 10 m up reach
+//    the pile at about 14 m/s). The 2D region with aspect 2 is as tall as it is wide.
 //  - the cells whose bodies (with any jitter) lie inside the region are listed, the list is
 //    shuffled (Fisher-Yates) and the first N are taken (if there are fewer than N, H grows by
 //    one layer at a time); the chosen cells are sorted bottom-up (z, then y, then x) so body i

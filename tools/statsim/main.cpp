@@ -2,9 +2,12 @@
 #include <CLI/CLI.hpp>
 
 #include "bench/bench.hpp"
+#include "export/export_commands.hpp"
 #include "mesh/mesh_commands.hpp"
 #include "ref2d/ref2d.hpp"
 #include "ref3d/ref3d.hpp"
+#include "render/render_commands.hpp"
+#include "stress/stress.hpp"
 
 int main(int argc, char** argv)
 {
@@ -15,6 +18,9 @@ int main(int argc, char** argv)
   statsim::tools::register_ref2d_commands(app);
   statsim::tools::register_bench_commands(app);
   statsim::tools::register_ref3d_commands(app);
+  statsim::tools::register_render_commands(app);
+  statsim::tools::register_export_commands(app);
+  statsim::tools::register_stress_commands(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -1,0 +1,341 @@
+// Firmware example: a 3D world of boxes (or L-shapes, or bunnies) and a 2D world of squares from
+// the committed tables, each stepped FIRMWARE_STEPS times, then one line per world with the step
+// count and the FNV-1a hash of its whole state (`state_hash()`: positions, orientations,
+// velocities, sleep states, random streams). The same file builds for the host (firmware_host)
+// and, with startup.cpp and mps2-an386.ld, for a Cortex-M4F under QEMU (see CMakeLists.txt here);
+// the two must print the same lines, bit for bit.
+//
+// Build-time choices (-D...): FIRMWARE_BODIES (bodies per world, 64), FIRMWARE_STEPS (2000),
+// FIRMWARE_SHAPE (0 box, 1 L-shape, 2 bunny), FIRMWARE_I16 (1: response tables as 16-bit
+// integers, quantised at compile time by the rule of `statsim gather --precision i16`).
+// FIRMWARE_TRACE (defined): also print the hash after every step. STATSIM_FIRMWARE is defined by
+// the Cortex-M build.
+
+#include <statsim/config.hpp>
+#ifdef STATSIM_FIRMWARE
+// Eigen's own assertion handler prints through stdio: route its checks to statsim's handler.
+#define eigen_assert(x) STATSIM_ASSERT(x)
+#define EIGEN_NO_IO
+#endif
+#include <statsim/world2.hpp>
+#include <statsim/world3.hpp>
+#include <tables/square2d.hpp>
+
+#ifndef FIRMWARE_BODIES
+#define FIRMWARE_BODIES 64
+#endif
+#ifndef FIRMWARE_STEPS
+#define FIRMWARE_STEPS 2000
+#endif
+#ifndef FIRMWARE_SHAPE
+#define FIRMWARE_SHAPE 0
+#endif
+#ifndef FIRMWARE_I16
+#define FIRMWARE_I16 0
+#endif
+
+#if FIRMWARE_SHAPE == 0
+#include <tables/box.hpp>
+#define FIRMWARE_TABLE statsim::tables::box
+#elif FIRMWARE_SHAPE == 1
+#include <tables/lshape.hpp>
+#define FIRMWARE_TABLE statsim::tables::lshape
+#elif FIRMWARE_SHAPE == 2
+#include <tables/bunny.hpp>
+#define FIRMWARE_TABLE statsim::tables::bunny
+#else
+#error "FIRMWARE_SHAPE must be 0 (box), 1 (L-shape) or 2 (bunny)"
+#endif
+
+#include <cstdint>
+
+// ---- platform: output and failure (startup.cpp on the Cortex-M, stdio on the host) -------------
+#ifdef STATSIM_FIRMWARE
+namespace platform {
+void write(const char* text);
+[[noreturn]] void fail();
+std::uint64_t clock_ticks();  ///< SysTick counts at 25 MHz; 40 instructions each under -icount shift=0
+std::uint32_t stack_used();   ///< high-water mark, bytes
+std::uint32_t stack_size();   ///< bytes
+}  // namespace platform
+#else
+#include <cstdio>
+#include <cstdlib>
+namespace platform {
+void write(const char* text) { std::fputs(text, stdout); }
+[[noreturn]] void fail() { std::exit(1); }
+}  // namespace platform
+#endif
+
+namespace {
+
+constexpr std::uint32_t bodies = FIRMWARE_BODIES;
+constexpr int steps = FIRMWARE_STEPS;
+constexpr statsim::Scalar dt = statsim::Scalar(1) / 60;
+// Candidate pairs per body (the broad phase pairs bounding spheres): piles of boxes peak at about
+// 2.3 per body, of bunnies at about 6 (a bunny's bounding radius, 0.16 m, is over twice the
+// 0.06 m it rests at). A step reports an overflow; this program then fails.
+constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 2 ? 8 : 3) * bodies;
+constexpr std::uint32_t pairs2 = 3 * bodies;
+// Scenes that grow with the body count: columns of bodies four high in 3D (k x k columns, k a
+// multiple of 4) and eight high in 2D.
+constexpr std::uint32_t grid_side(std::uint32_t n, std::uint32_t height, std::uint32_t step, std::uint32_t power)
+{
+  std::uint32_t k = step;
+  while ((power == 2 ? k * k : k) * height < n) k += step;
+  return k;
+}
+constexpr std::uint32_t columns3 = grid_side(bodies, 4, 4, 2);
+constexpr std::uint32_t columns2 = grid_side(bodies, 8, 8, 1);
+
+// ---- compile-time quantisation of a float table to 16 bits ---------------------------------------
+// The rule of tools/ref3d/gather.cpp (quantize): offset = mid-range, scale = range / 65534, q the
+// nearest integer (ties to even) of (value - offset) / scale in double precision.
+constexpr double round_half_even(double x)
+{
+  const double t = double(static_cast<long long>(x));  // truncated toward zero
+  const double r = x - t;
+  const bool odd = static_cast<long long>(t) % 2 != 0;
+  if (r > 0.5 || (r == 0.5 && odd)) return t + 1;
+  if (r < -0.5 || (r == -0.5 && odd)) return t - 1;
+  return t;
+}
+
+template <std::size_t N>
+constexpr void quantise(const std::array<float, N>& v, float& scale, float& offset, std::array<std::int16_t, N>& q)
+{
+  float lo = v[0], hi = v[0];
+  for (std::size_t i = 0; i < N; ++i) {
+    lo = v[i] < lo ? v[i] : lo;
+    hi = v[i] > hi ? v[i] : hi;
+  }
+  offset = 0.5f * (lo + hi);
+  scale = hi > lo ? (hi - lo) / 65534.0f : 1.0f;
+  for (std::size_t i = 0; i < N; ++i) {
+    const double r = round_half_even((double(v[i]) - double(offset)) / double(scale));
+    q[i] = static_cast<std::int16_t>(r < -32767 ? -32767 : r > 32767 ? 32767 : r);
+  }
+}
+
+template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
+          std::uint32_t NR>
+constexpr statsim::SignatureQ16<D, NH, A0, A1, A2, A3, NR> to_q16(const statsim::Signature<D, NH, A0, A1, A2, A3, NR>& s)
+{
+  statsim::SignatureQ16<D, NH, A0, A1, A2, A3, NR> q{};
+  q.name = s.name;
+  q.length = s.length;
+  q.bounding_radius = s.bounding_radius;
+  q.mass = s.mass;
+  q.unit_inertia = s.unit_inertia;
+  q.material = s.material;
+  q.restitution_threshold = s.restitution_threshold;
+  q.layout = s.layout;
+  q.axis_count = s.axis_count;
+  q.height_axis = s.height_axis;
+  q.height_mean = s.height_mean;
+  q.height_stddev = s.height_stddev;
+  q.axis0 = s.axis0;
+  q.axis1 = s.axis1;
+  q.axis2 = s.axis2;
+  q.axis3 = s.axis3;
+  quantise(s.response_mean, q.mean_scale, q.mean_offset, q.response_mean);
+  quantise(s.response_stddev, q.stddev_scale, q.stddev_offset, q.response_stddev);
+  q.rest_normals = s.rest_normals;
+  q.rest_heights = s.rest_heights;
+  q.rest_frequencies = s.rest_frequencies;
+  return q;
+}
+
+#if FIRMWARE_I16
+constexpr auto table3 = to_q16(FIRMWARE_TABLE);
+constexpr auto table2 = to_q16(statsim::tables::square2d);
+constexpr const char* precision = "i16";
+#else
+constexpr const auto& table3 = FIRMWARE_TABLE;
+constexpr const auto& table2 = statsim::tables::square2d;
+constexpr const char* precision = "f32";
+#endif
+
+// ---- output without printf (newlib's printf allocates) -------------------------------------------
+class Line {
+ public:
+  Line& text(const char* s)
+  {
+    while (*s && n_ + 1 < sizeof buf_) buf_[n_++] = *s++;
+    return *this;
+  }
+  Line& dec(std::uint64_t v)
+  {
+    char digits[20];
+    int k = 0;
+    do {
+      digits[k++] = char('0' + v % 10);
+      v /= 10;
+    } while (v);
+    while (k > 0 && n_ + 1 < sizeof buf_) buf_[n_++] = digits[--k];
+    return *this;
+  }
+  Line& hex(std::uint64_t v)
+  {
+    text("0x");
+    for (int shift = 60; shift >= 0 && n_ + 1 < sizeof buf_; shift -= 4) buf_[n_++] = "0123456789abcdef"[(v >> shift) & 0xfu];
+    return *this;
+  }
+  void emit()
+  {
+    buf_[n_++] = '\n';
+    buf_[n_] = '\0';
+    platform::write(buf_);
+    n_ = 0;
+  }
+
+ private:
+  char buf_[200];
+  std::size_t n_ = 0;
+};
+
+void on_assert(const char* expression, const char* file, int line)
+{
+  Line().text("assertion failed: ").text(expression).text(" at ").text(file).text(":").dec(std::uint64_t(line)).emit();
+  platform::fail();
+}
+
+// The worlds live in static storage: constructed by the start-up code before main, no heap.
+statsim::World3<bodies, 8, pairs3, 2> world3;
+statsim::World2<bodies, 8, pairs2, 2> world2;
+
+/// A unit quaternion from four uniform draws (normalising a random 4-vector; no trigonometry).
+statsim::Quaternion random_orientation(statsim::Pcg32& rng)
+{
+  const float w = rng.uniform(-1, 1);
+  const float x = rng.uniform(-1, 1);
+  const float y = rng.uniform(-1, 1);
+  const float z = rng.uniform(-1, 1);
+  return statsim::detail::normalized(statsim::Quaternion(w + 2, x, y, z));
+}
+
+bool build_world3()
+{
+  const auto shape = world3.add_shape(table3.view());
+  if (!shape.ok()) return false;
+  using statsim::Vector3;
+  // A bin open at the top, 0.3 m per column of bodies: k x k columns, four bodies high (64 bodies:
+  // 4 x 4 columns in 1.2 x 1.2 m), piling about two deep.
+  const float half = 0.15f * float(columns3);
+  const bool planes = world3.add_plane(Vector3(0, 0, 1), 0).ok() && world3.add_plane(Vector3(1, 0, 0), -half).ok() &&
+                      world3.add_plane(Vector3(-1, 0, 0), -half).ok() && world3.add_plane(Vector3(0, 1, 0), -half).ok() &&
+                      world3.add_plane(Vector3(0, -1, 0), -half).ok();
+  if (!planes) return false;
+  statsim::Pcg32 rng(7, 3);
+  for (std::uint32_t i = 0; i < bodies; ++i) {
+    statsim::BodyDef3 def;
+    def.shape = shape.id;
+    const std::uint32_t cx = i % columns3, cy = (i / columns3) % columns3, layer = i / (columns3 * columns3);
+    def.position = Vector3(0.15f - half + 0.3f * float(cx), 0.15f - half + 0.3f * float(cy), 0.5f + 0.4f * float(layer));
+    def.orientation = random_orientation(rng);
+    const float vx = rng.uniform(-1, 1);
+    const float vy = rng.uniform(-1, 1);
+    const float wx = rng.uniform(-5, 5);
+    const float wy = rng.uniform(-5, 5);
+    const float wz = rng.uniform(-5, 5);
+    def.linear_velocity = Vector3(vx, vy, 0);
+    def.angular_velocity = Vector3(wx, wy, wz);
+    def.mass = table3.mass;
+    if (!world3.add_body(def).ok()) return false;
+  }
+  return true;
+}
+
+bool build_world2()
+{
+  const auto shape = world2.add_shape(table2.view());
+  if (!shape.ok()) return false;
+  using statsim::Vector2;
+  // A bin 1.25 m wide per column of 1 m squares, the columns eight squares high (64 bodies:
+  // 8 columns in 10 m), piling about six deep.
+  const float half = 0.625f * float(columns2);
+  if (!world2.add_plane(Vector2(0, 1), 0).ok() || !world2.add_plane(Vector2(1, 0), -half).ok() ||
+      !world2.add_plane(Vector2(-1, 0), -half).ok())
+    return false;
+  statsim::Pcg32 rng(7, 2);
+  for (std::uint32_t i = 0; i < bodies; ++i) {
+    statsim::BodyDef2 def;
+    def.shape = shape.id;
+    def.position = Vector2(0.8f - half + 1.2f * float(i % columns2), 1.0f + 1.6f * float(i / columns2));
+    const float c = rng.uniform(-1, 1);
+    const float s = rng.uniform(-1, 1);
+    def.orientation = statsim::detail::normalized(statsim::Rot2{c + 1.5f, s});
+    const float vx = rng.uniform(-2, 2);
+    const float w = rng.uniform(-6, 6);
+    def.linear_velocity = Vector2(vx, 0);
+    def.angular_velocity = w;
+    def.mass = table2.mass;
+    if (!world2.add_body(def).ok()) return false;
+  }
+  return true;
+}
+
+/// Steps a world and prints its line; returns false if a step failed or dropped pairs.
+template <class World>
+bool run(World& world, const char* label, const char* table)
+{
+  std::uint64_t dropped = 0;
+  std::uint32_t peak_pairs = 0;
+  bool ok = true;
+#ifdef STATSIM_FIRMWARE
+  const std::uint64_t t0 = platform::clock_ticks();
+#endif
+  for (int i = 0; i < steps; ++i) {
+    const statsim::StepResult r = world.step(dt);
+    ok = ok && r.status == statsim::Status::ok;
+    dropped += r.pairs_dropped;
+    peak_pairs = r.pairs_found > peak_pairs ? r.pairs_found : peak_pairs;
+#ifdef FIRMWARE_TRACE
+    // To find where two builds part: the hash after every step.
+    Line().text(label).text(" step ").dec(std::uint64_t(i + 1)).text(" hash ").hex(world.state_hash()).emit();
+#endif
+  }
+#ifdef STATSIM_FIRMWARE
+  const std::uint64_t ticks = platform::clock_ticks() - t0;
+#endif
+  Line()
+      .text(label)
+      .text(" ")
+      .text(table)
+      .text(" ")
+      .text(precision)
+      .text(" bodies ")
+      .dec(world.body_count())
+      .text(" steps ")
+      .dec(world.step_count())
+      .text(" asleep ")
+      .dec(world.count(statsim::MotionState::asleep))
+      .text(" peak_pairs ")
+      .dec(peak_pairs)
+      .text(" dropped ")
+      .dec(dropped)
+      .text(" hash ")
+      .hex(world.state_hash())
+      .emit();
+#ifdef STATSIM_FIRMWARE
+  Line().text("firmware: ").text(label).text(" systick ").dec(ticks).text(" steps ").dec(std::uint64_t(steps)).emit();
+#endif
+  return ok && dropped == 0;
+}
+
+}  // namespace
+
+int main()
+{
+  statsim::set_assert_handler(&on_assert);
+  if (!build_world3() || !build_world2()) {
+    Line().text("firmware: could not build the worlds").emit();
+    return 1;
+  }
+  const bool ok3 = run(world3, "world3", table3.name);
+  const bool ok2 = run(world2, "world2", table2.name);
+#ifdef STATSIM_FIRMWARE
+  Line().text("firmware: stack used ").dec(platform::stack_used()).text(" of ").dec(platform::stack_size()).text(" bytes").emit();
+#endif
+  return ok3 && ok2 ? 0 : 1;
+}

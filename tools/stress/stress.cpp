@@ -1,0 +1,1211 @@
+// `statsim stress` (issue 8): see stress.hpp. Every scene is built from fixed seeds, so a run is
+// repeatable; wall-clock figures (ms per step) are the only ones that vary between runs.
+//
+// Methods. 3D: full, low, spheres7, sphere = Bullet 3.24 (double precision) with the benchmark's
+// representations of the bunny (btGImpactMeshShape of the full and the ~100-vertex mesh, a
+// compound of 7 spheres, one sphere of the table's zero-spin collision radius), margins 2 mm,
+// material and sleeping thresholds of the statistical table, stepSimulation(dt, 0), no CCD;
+// statistical = statsim World3 with tables/bunny.hpp and the runtime's defaults.
+// 2D: polygon = Box2D 2.4.1 unit square (velocity 8, position 3 iterations, its default CCD);
+// statistical2d = statsim World2 with tables/square2d.hpp.
+#include "stress/stress.hpp"
+
+#include "bench/bench_internal.hpp"
+#include "bench/bullet.hpp"
+#include "scenes/scenes.hpp"
+
+#include "statsim/world2.hpp"
+#include "statsim/world3.hpp"
+#include "tables/bunny.hpp"
+#include "tables/square2d.hpp"
+
+#include <box2d/box2d.h>
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace statsim::tools {
+namespace {
+
+using bench::Body3;
+using Clock = std::chrono::steady_clock;
+constexpr double kG = 9.81;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+const std::vector<std::string> kMethods3 = {"full", "low", "spheres7", "sphere", "statistical"};
+const std::vector<std::string> kMethods2 = {"polygon", "statistical2d"};
+
+std::string fmt(const char* f, ...)
+{
+  char buf[512];
+  va_list ap;
+  va_start(ap, f);
+  std::vsnprintf(buf, sizeof buf, f, ap);
+  va_end(ap);
+  return buf;
+}
+
+double seconds_since(Clock::time_point t0)
+{
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+bool finite3(const Eigen::Vector3d& v)
+{
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+/// Plane n.x = offset (n unit), the solid side where n.x > offset.
+struct PlaneSpec {
+  Eigen::Vector3d normal;
+  double offset;
+};
+
+/// Per-body state every 3D method reports.
+struct State3 {
+  Eigen::Vector3d x, v, w;
+  Eigen::Quaterniond q;
+  double radius = 0;  ///< statsim's current collision radius; 0 for Bullet
+  bool asleep = false;
+};
+
+/// Lowest point of a representation below its centre, for orientation q: min over its geometry of
+/// (R p).z (negative).
+double lowest_offset(const Body3& body, const std::string& method, const Eigen::Quaterniond& q)
+{
+  const Eigen::Matrix3d r = q.toRotationMatrix();
+  double lo = kInf;
+  if (method == "full" || method == "low") {
+    const auto& vs = method == "full" ? body.full_vertices : body.low_vertices;
+    for (const auto& p : vs) lo = std::min(lo, r.row(2).dot(p));
+  } else if (method == "spheres7") {
+    for (const auto& s : body.spheres) lo = std::min(lo, r.row(2).dot(s.head<3>()) - s[3]);
+  } else {
+    lo = -body.sphere_radius;
+  }
+  return lo;
+}
+
+// ---- a 3D world of any method ---------------------------------------------------------------------
+class Sim3 {
+public:
+  virtual ~Sim3() = default;
+  virtual void step(double dt) = 0;
+  virtual std::size_t size() const = 0;
+  virtual State3 state(std::size_t i) const = 0;
+  virtual double kinetic_energy() const = 0;
+  /// Deepest overlap now: statsim between collision spheres (fraction of their radius sum);
+  /// Bullet the deepest contact point of any manifold (m).
+  virtual double overlap() const = 0;
+  /// Height of the lowest point of body i above z = 0 (negative: below the ground).
+  virtual double lowest(std::size_t i) const = 0;
+};
+
+struct Setup3 {
+  std::vector<PlaneSpec> planes{{Eigen::Vector3d(0, 0, 1), 0.0}};
+  Eigen::Vector3d gravity{0, 0, -kG};
+  /// Bullet material; statsim uses the table's (or `particle`'s).
+  double restitution = -1, friction = -1;  // < 0: the table's
+  bool sleeping = true;
+  /// statsim: plain spheres of the table's zero-spin radius with this material instead of the
+  /// statistical shape (the particle model).
+  bool particle = false;
+};
+
+// Bullet ------------------------------------------------------------------------------------------
+btVector3 bt(const Eigen::Vector3d& v)
+{
+  return btVector3(v.x(), v.y(), v.z());
+}
+Eigen::Vector3d eig(const btVector3& v)
+{
+  return Eigen::Vector3d(v.x(), v.y(), v.z());
+}
+
+class BulletSim3 final : public Sim3 {
+public:
+  BulletSim3(const Body3& body, const std::string& method, const Setup3& setup,
+             const std::vector<scenes::BodyState3>& states)
+      : body_(body), method_(method)
+  {
+    const int n = static_cast<int>(states.size());
+    btDefaultCollisionConstructionInfo cci;
+    cci.m_defaultMaxPersistentManifoldPoolSize = std::max(4096, 4 * n);
+    cci.m_defaultMaxCollisionAlgorithmPoolSize = std::max(4096, 4 * n);
+    config_ = std::make_unique<btDefaultCollisionConfiguration>(cci);
+    dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
+    btGImpactCollisionAlgorithm::registerAlgorithm(dispatcher_.get());
+    broadphase_ = std::make_unique<btDbvtBroadphase>();
+    solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+    world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
+                                                       config_.get());
+    world_->setGravity(bt(setup.gravity));
+    world_->getSolverInfo().m_restitutionVelocityThreshold = body.surface.restitution_threshold;
+    gDeactivationTime = body.surface.sleep_time;
+    make_shape();
+    const double e = setup.restitution >= 0 ? setup.restitution : body.surface.restitution;
+    const double mu = setup.friction >= 0 ? setup.friction : body.surface.friction;
+    // Bullet multiplies the two sides' coefficients: sqrt on each gives every contact e and mu.
+    const double se = std::sqrt(e), smu = std::sqrt(mu);
+    for (const PlaneSpec& p : setup.planes) {
+      planes_.push_back(std::make_unique<btStaticPlaneShape>(bt(p.normal), p.offset));
+      btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, planes_.back().get());
+      info.m_friction = smu;
+      info.m_restitution = se;
+      statics_.push_back(std::make_unique<btRigidBody>(info));
+      world_->addRigidBody(statics_.back().get());
+    }
+    const double rolling =
+        method == "sphere" && smu > 0 ? body.surface.rolling_resistance * body.sphere_radius / smu : 0.0;
+    inertia_ = body.inertia;
+    for (const scenes::BodyState3& s : states) {
+      btRigidBody::btRigidBodyConstructionInfo info(body.mass, nullptr, shape_, bt(body.inertia));
+      info.m_friction = smu;
+      info.m_restitution = se;
+      info.m_rollingFriction = setup.friction == 0 ? 0.0 : rolling;
+      info.m_linearSleepingThreshold = body.surface.sleep_speed;
+      info.m_angularSleepingThreshold = body.surface.sleep_speed / body.bounding_radius;
+      const Eigen::Quaterniond& q = s.orientation;
+      info.m_startWorldTransform = btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), bt(s.position));
+      auto rb = std::make_unique<btRigidBody>(info);
+      rb->setLinearVelocity(bt(s.linear_velocity));
+      rb->setAngularVelocity(bt(s.angular_velocity));
+      if (!setup.sleeping) rb->setActivationState(DISABLE_DEACTIVATION);
+      world_->addRigidBody(rb.get());
+      bodies_.push_back(std::move(rb));
+    }
+  }
+  ~BulletSim3() override { world_.reset(); }
+
+  void step(double dt) override { world_->stepSimulation(dt, 0); }
+  std::size_t size() const override { return bodies_.size(); }
+  State3 state(std::size_t i) const override
+  {
+    const btRigidBody& b = *bodies_[i];
+    State3 s;
+    s.x = eig(b.getCenterOfMassPosition());
+    s.v = eig(b.getLinearVelocity());
+    s.w = eig(b.getAngularVelocity());
+    const btQuaternion q = b.getOrientation();
+    s.q = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
+    s.asleep = b.getActivationState() == ISLAND_SLEEPING;
+    return s;
+  }
+  double kinetic_energy() const override
+  {
+    double ke = 0;
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      const State3 s = state(i);
+      const Eigen::Vector3d wb = s.q.conjugate() * s.w;
+      ke += 0.5 * body_.mass * s.v.squaredNorm() + 0.5 * wb.dot(inertia_.cwiseProduct(wb));
+    }
+    return ke;
+  }
+  double overlap() const override
+  {
+    double deepest = 0;
+    btDispatcher* d = world_->getDispatcher();
+    for (int i = 0; i < d->getNumManifolds(); ++i) {
+      const btPersistentManifold* m = d->getManifoldByIndexInternal(i);
+      for (int k = 0; k < m->getNumContacts(); ++k)
+        deepest = std::max(deepest, -double(m->getContactPoint(k).getDistance()));
+    }
+    return deepest;
+  }
+  double lowest(std::size_t i) const override
+  {
+    const State3 s = state(i);
+    return s.x.z() + lowest_offset(body_, method_, s.q);
+  }
+
+private:
+  void make_shape()
+  {
+    if (method_ == "full" || method_ == "low") {
+      const auto& vs = method_ == "full" ? body_.full_vertices : body_.low_vertices;
+      indices_ = method_ == "full" ? body_.full_indices : body_.low_indices;
+      for (const auto& p : vs) vertices_.insert(vertices_.end(), {p.x(), p.y(), p.z()});
+      array_ = std::make_unique<btTriangleIndexVertexArray>(
+          static_cast<int>(indices_.size() / 3), indices_.data(), static_cast<int>(3 * sizeof(int)),
+          static_cast<int>(vs.size()), vertices_.data(), static_cast<int>(3 * sizeof(btScalar)));
+      auto mesh = std::make_unique<btGImpactMeshShape>(array_.get());
+      mesh->setMargin(0.002);
+      mesh->updateBound();
+      shape_ = mesh.get();
+      owned_ = std::move(mesh);
+    } else if (method_ == "spheres7") {
+      auto compound = std::make_unique<btCompoundShape>();
+      for (const auto& s : body_.spheres) {
+        children_.push_back(std::make_unique<btSphereShape>(s[3]));
+        btTransform t;
+        t.setIdentity();
+        t.setOrigin(btVector3(s[0], s[1], s[2]));
+        compound->addChildShape(t, children_.back().get());
+      }
+      shape_ = compound.get();
+      owned_ = std::move(compound);
+    } else {
+      auto sphere = std::make_unique<btSphereShape>(body_.sphere_radius);
+      shape_ = sphere.get();
+      owned_ = std::move(sphere);
+    }
+  }
+
+  const Body3& body_;
+  std::string method_;
+  Eigen::Vector3d inertia_;
+  std::vector<btScalar> vertices_;
+  std::vector<int> indices_;
+  std::unique_ptr<btTriangleIndexVertexArray> array_;
+  std::vector<std::unique_ptr<btSphereShape>> children_;
+  std::unique_ptr<btCollisionShape> owned_;
+  btCollisionShape* shape_ = nullptr;
+  std::unique_ptr<btDefaultCollisionConfiguration> config_;
+  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btBroadphaseInterface> broadphase_;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
+  std::vector<std::unique_ptr<btStaticPlaneShape>> planes_;
+  std::vector<std::unique_ptr<btRigidBody>> statics_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  std::unique_ptr<btDiscreteDynamicsWorld> world_;  // destroyed first (declared last)
+};
+
+// statsim 3D --------------------------------------------------------------------------------------
+template <std::uint32_t Cap>
+class StatsimSim3 final : public Sim3 {
+public:
+  using WorldT = World3<Cap, 8, Cap * 32, 2>;
+
+  StatsimSim3(const Body3& body, const Setup3& setup, const std::vector<scenes::BodyState3>& states)
+      : sig_(tables::bunny.view()), particle_(setup.particle)
+  {
+    if (states.size() > Cap) throw std::runtime_error("stress: statsim world too small");
+    WorldDef3 def;
+    def.gravity = setup.gravity.cast<Scalar>();
+    world_ = std::make_unique<WorldT>(def);
+    Added<ShapeId> shape;
+    if (setup.particle) {
+      ShapeDef sd;
+      sd.radius = sig_.height.mean[0];
+      sd.material.restitution = static_cast<Scalar>(setup.restitution >= 0 ? setup.restitution : 0.3);
+      sd.material.friction = static_cast<Scalar>(setup.friction >= 0 ? setup.friction : 0.5);
+      sd.material.rolling_resistance = setup.friction == 0 ? 0 : sd.material.rolling_resistance;
+      shape = world_->add_shape(sd);
+    } else {
+      shape = world_->add_shape(sig_);
+    }
+    if (!shape.ok()) throw std::runtime_error(std::string("statsim add_shape: ") + to_string(shape.status));
+    for (const PlaneSpec& p : setup.planes) {
+      const auto added = world_->add_plane(p.normal.cast<Scalar>(), static_cast<Scalar>(p.offset));
+      if (!added.ok()) throw std::runtime_error(std::string("statsim add_plane: ") + to_string(added.status));
+    }
+    mass_ = static_cast<double>(sig_.mass);
+    (void)body;
+    for (const scenes::BodyState3& s : states) {
+      BodyDef3 b;
+      b.position = s.position.cast<Scalar>();
+      b.orientation = s.orientation.cast<Scalar>().normalized();
+      b.linear_velocity = s.linear_velocity.cast<Scalar>();
+      b.angular_velocity = s.angular_velocity.cast<Scalar>();
+      b.shape = shape.id;
+      b.mass = static_cast<Scalar>(mass_);
+      const Added<BodyId> added = world_->add_body(b);
+      if (!added.ok()) throw std::runtime_error(std::string("statsim add_body: ") + to_string(added.status));
+    }
+  }
+  void step(double dt) override
+  {
+    last_ = world_->step(static_cast<Scalar>(dt));
+    if (last_.status != Status::ok) throw std::runtime_error(std::string("statsim step: ") + to_string(last_.status));
+    dropped_ = std::max(dropped_, last_.pairs_dropped);
+  }
+  std::size_t size() const override { return world_->body_count(); }
+  State3 state(std::size_t i) const override
+  {
+    const Body<3>& b = world_->body(static_cast<BodyId>(i));
+    State3 s;
+    s.x = b.position.cast<double>();
+    s.v = b.linear_velocity.cast<double>();
+    s.w = b.angular_velocity.cast<double>();
+    s.q = b.orientation.cast<double>();
+    s.radius = double(b.radius);
+    s.asleep = b.state == MotionState::asleep;
+    return s;
+  }
+  double kinetic_energy() const override
+  {
+    double ke = 0;
+    for (std::uint32_t i = 0; i < world_->body_count(); ++i) {
+      const Body<3>& b = world_->body(i);
+      ke += particle_ ? 0.5 * mass_ * double(b.linear_velocity.squaredNorm())
+                      : mass_ * double(kinetic_energy_per_mass<3>(sig_, b.orientation, b.linear_velocity,
+                                                                  b.angular_velocity));
+    }
+    return ke;
+  }
+  double overlap() const override
+  {
+    // Every pair of collision spheres, asleep or not (the broad phase skips sleeping pairs): a
+    // sweep along x.
+    const std::uint32_t n = world_->body_count();
+    std::vector<std::pair<double, std::uint32_t>> xs(n);
+    double rmax = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      xs[i] = {double(world_->body(i).position.x()), i};
+      rmax = std::max(rmax, double(world_->body(i).radius));
+    }
+    std::sort(xs.begin(), xs.end());
+    double deepest = 0;
+    for (std::uint32_t i = 0; i < n; ++i)
+      for (std::uint32_t j = i + 1; j < n && xs[j].first - xs[i].first < 2 * rmax; ++j) {
+        const Body<3>& a = world_->body(xs[i].second);
+        const Body<3>& b = world_->body(xs[j].second);
+        const double sum = double(a.radius) + double(b.radius);
+        const double d = double((a.position - b.position).norm());
+        deepest = std::max(deepest, (sum - d) / sum);
+      }
+    return deepest;
+  }
+  double lowest(std::size_t i) const override
+  {
+    const Body<3>& b = world_->body(static_cast<BodyId>(i));
+    return double(b.position.z()) - double(b.radius);
+  }
+  std::uint32_t pairs_dropped() const { return dropped_; }
+  std::uint64_t hash() const { return world_->state_hash(); }
+  const WorldT& world() const { return *world_; }
+
+private:
+  SignatureView<3> sig_;
+  bool particle_;
+  double mass_ = 1;
+  std::unique_ptr<WorldT> world_;
+  StepResult last_{};
+  std::uint32_t dropped_ = 0;
+};
+
+std::unique_ptr<Sim3> make_sim3(const Body3& body, const std::string& method, const Setup3& setup,
+                                const std::vector<scenes::BodyState3>& states)
+{
+  if (method == "statistical") {
+    if (states.size() <= 1024) return std::make_unique<StatsimSim3<1024>>(body, setup, states);
+    return std::make_unique<StatsimSim3<16384>>(body, setup, states);
+  }
+  return std::make_unique<BulletSim3>(body, method, setup, states);
+}
+
+// ---- 2D: Box2D polygon and statsim ------------------------------------------------------------------
+struct State2 {
+  Eigen::Vector2d x, v;
+  double lowest = 0;  ///< height of the lowest point above y = 0
+};
+
+class Sim2 {
+public:
+  virtual ~Sim2() = default;
+  virtual void step(double dt) = 0;
+  virtual std::size_t size() const = 0;
+  virtual State2 state(std::size_t i) const = 0;
+};
+
+class Box2dSim final : public Sim2 {
+public:
+  Box2dSim(const std::vector<scenes::BodyState2>& states, double mass, double e, double mu)
+      : world_(b2Vec2(0.0f, float(-kG)))
+  {
+    b2BodyDef gd;
+    b2Body* ground = world_.CreateBody(&gd);
+    b2EdgeShape edge;
+    edge.SetTwoSided(b2Vec2(-1000.0f, 0.0f), b2Vec2(1000.0f, 0.0f));
+    b2FixtureDef gf;
+    gf.shape = &edge;
+    gf.friction = float(mu);
+    gf.restitution = float(e);
+    ground->CreateFixture(&gf);
+    box_.SetAsBox(0.5f, 0.5f);
+    for (const auto& s : states) {
+      b2BodyDef bd;
+      bd.type = b2_dynamicBody;
+      bd.position.Set(float(s.position.x()), float(s.position.y()));
+      bd.angle = float(s.angle);
+      bd.linearVelocity.Set(float(s.linear_velocity.x()), float(s.linear_velocity.y()));
+      bd.angularVelocity = float(s.angular_velocity);
+      b2Body* b = world_.CreateBody(&bd);
+      b2FixtureDef fd;
+      fd.shape = &box_;
+      fd.density = float(mass);  // unit area
+      fd.friction = float(mu);
+      fd.restitution = float(e);
+      b->CreateFixture(&fd);
+      bodies_.push_back(b);
+    }
+  }
+  void step(double dt) override { world_.Step(float(dt), 8, 3); }
+  std::size_t size() const override { return bodies_.size(); }
+  State2 state(std::size_t i) const override
+  {
+    const b2Body* b = bodies_[i];
+    State2 s;
+    s.x = Eigen::Vector2d(b->GetPosition().x, b->GetPosition().y);
+    s.v = Eigen::Vector2d(b->GetLinearVelocity().x, b->GetLinearVelocity().y);
+    s.lowest = kInf;
+    for (int k = 0; k < box_.m_count; ++k)
+      s.lowest = std::min(s.lowest, double(b->GetWorldPoint(box_.m_vertices[k]).y));
+    return s;
+  }
+
+private:
+  b2World world_;
+  b2PolygonShape box_;
+  std::vector<b2Body*> bodies_;
+};
+
+class StatsimSim2 final : public Sim2 {
+public:
+  explicit StatsimSim2(const std::vector<scenes::BodyState2>& states)
+  {
+    world_ = std::make_unique<World2<256, 4, 256 * 16, 2>>();
+    const SignatureView<2> sig = tables::square2d.view();
+    const auto shape = world_->add_shape(sig);
+    world_->add_plane(Vector2(0, 1), 0);
+    for (const auto& s : states) {
+      BodyDef<2> b;
+      b.position = s.position.cast<Scalar>();
+      b.orientation = Rot2{Scalar(std::cos(s.angle)), Scalar(std::sin(s.angle))};
+      b.linear_velocity = s.linear_velocity.cast<Scalar>();
+      b.angular_velocity = Scalar(s.angular_velocity);
+      b.shape = shape.id;
+      b.mass = sig.mass;
+      if (!world_->add_body(b).ok()) throw std::runtime_error("statsim 2D add_body failed");
+    }
+  }
+  void step(double dt) override { world_->step(static_cast<Scalar>(dt)); }
+  std::size_t size() const override { return world_->body_count(); }
+  State2 state(std::size_t i) const override
+  {
+    const Body<2>& b = world_->body(static_cast<BodyId>(i));
+    State2 s;
+    s.x = b.position.cast<double>();
+    s.v = b.linear_velocity.cast<double>();
+    s.lowest = double(b.position.y()) - double(b.radius);
+    return s;
+  }
+
+private:
+  std::unique_ptr<World2<256, 4, 256 * 16, 2>> world_;
+};
+
+// ---- the matrix -------------------------------------------------------------------------------------
+class Matrix {
+public:
+  Matrix(const StressOptions& o, Body3 body) : opt_(o), body_(std::move(body)) {}
+
+  bool want(const std::string& m) const
+  {
+    return opt_.methods.empty() || std::find(opt_.methods.begin(), opt_.methods.end(), m) != opt_.methods.end();
+  }
+  std::vector<std::string> methods3() const
+  {
+    std::vector<std::string> r;
+    for (const auto& m : kMethods3)
+      if (want(m)) r.push_back(m);
+    return r;
+  }
+  void add(const std::string& scene, const std::string& method, bool pass, const std::string& figure,
+           const std::string& criterion)
+  {
+    cells_.push_back({scene, method, pass, figure, criterion});
+    if (opt_.progress)
+      std::fprintf(stderr, "stress: %-34s %-13s %s  %s\n", scene.c_str(), method.c_str(), pass ? "pass" : "FAIL",
+                   figure.c_str());
+  }
+  std::vector<StressCell> take() { return std::move(cells_); }
+
+  const Body3& body() const { return body_; }
+  const StressOptions& opt() const { return opt_; }
+  double R() const { return body_.bounding_radius; }
+  double budget() const { return opt_.quick ? std::min(opt_.budget_s, 20.0) : opt_.budget_s; }
+
+  void fast_impact();
+  void large_time_step();
+  void deep_pile();
+  void energy();
+  void out_of_range();
+  void long_run();
+  void bad_input();
+
+private:
+  StressOptions opt_;
+  Body3 body_;
+  std::vector<StressCell> cells_;
+};
+
+Eigen::Quaterniond random_q(scenes::SceneRng& rng)
+{
+  for (;;) {
+    const Eigen::Vector4d p(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    const double n2 = p.squaredNorm();
+    if (n2 > 1e-6 && n2 <= 1) return Eigen::Quaterniond(p[0], p[1], p[2], p[3]).normalized();
+  }
+}
+
+// 1. fast impact ---------------------------------------------------------------------------------------
+void Matrix::fast_impact()
+{
+  const int side = opt_.quick ? 3 : 5;
+  const double dt = 1.0 / 60, T = 1.5;
+  const int steps = static_cast<int>(std::lround(T / dt));
+  for (const double speed : {5.0, 20.0, 50.0}) {
+    const std::string scene = fmt("fast impact %.0f m/s", speed);
+    // Tunnelled: the centre ever more than R below the ground, or below it at the end.
+    const std::string criterion = fmt("tunnelled (centre ever below -R, or below 0 at the end) = 0 and max "
+                                      "penetration <= 0.25 R (%.1f cm)",
+                                      25 * R());
+    std::vector<scenes::BodyState3> states;
+    scenes::SceneRng rng(11);
+    for (int i = 0; i < side; ++i)
+      for (int j = 0; j < side; ++j) {
+        scenes::BodyState3 s;
+        s.position = Eigen::Vector3d((i - (side - 1) / 2.0) * 5 * R(), (j - (side - 1) / 2.0) * 5 * R(), 0.5);
+        s.orientation = random_q(rng);
+        s.linear_velocity = Eigen::Vector3d(0, 0, -speed);
+        s.angular_velocity = Eigen::Vector3d(rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2));
+        states.push_back(s);
+      }
+    for (const std::string& m : methods3()) {
+      auto sim = make_sim3(body_, m, Setup3{}, states);
+      double pen = 0;
+      std::vector<bool> through(states.size(), false);
+      for (int k = 0; k < steps; ++k) {
+        sim->step(dt);
+        for (std::size_t i = 0; i < sim->size(); ++i) {
+          pen = std::max(pen, -sim->lowest(i));
+          const State3 s = sim->state(i);
+          if (!finite3(s.x) || s.x.z() < -R()) through[i] = true;
+        }
+      }
+      int tunnelled = 0;
+      for (std::size_t i = 0; i < sim->size(); ++i) tunnelled += through[i] || sim->state(i).x.z() < 0;
+      add(scene, m, tunnelled == 0 && pen <= 0.25 * R(),
+          fmt("tunnelled %d/%zu, max penetration %.1f cm", tunnelled, states.size(), 100 * pen), criterion);
+    }
+    // 2D: unit squares (R = 0.707 m).
+    std::vector<scenes::BodyState2> states2;
+    for (int i = 0; i < side; ++i) {
+      scenes::BodyState2 s;
+      s.position = Eigen::Vector2d((i - (side - 1) / 2.0) * 3.0, 1.5);
+      s.angle = rng.uniform(0, 6.283185307179586);
+      s.linear_velocity = Eigen::Vector2d(0, -speed);
+      s.angular_velocity = rng.uniform(-2, 2);
+      states2.push_back(s);
+    }
+    const double r2 = 0.70710678118654752;
+    for (const std::string& m : kMethods2) {
+      if (!want(m)) continue;
+      std::unique_ptr<Sim2> sim;
+      if (m == "polygon")
+        sim = std::make_unique<Box2dSim>(states2, double(tables::square2d.mass),
+                                         double(tables::square2d.material.restitution),
+                                         double(tables::square2d.material.friction));
+      else
+        sim = std::make_unique<StatsimSim2>(states2);
+      double pen = 0;
+      std::vector<bool> through(states2.size(), false);
+      for (int k = 0; k < steps; ++k) {
+        sim->step(dt);
+        for (std::size_t i = 0; i < sim->size(); ++i) {
+          const State2 s = sim->state(i);
+          pen = std::max(pen, -s.lowest);
+          if (!std::isfinite(s.x.y()) || s.x.y() < -r2) through[i] = true;
+        }
+      }
+      int tunnelled = 0;
+      for (std::size_t i = 0; i < sim->size(); ++i) tunnelled += through[i] || sim->state(i).x.y() < 0;
+      add(scene + " (2D)", m, tunnelled == 0 && pen <= 0.25 * r2,
+          fmt("tunnelled %d/%zu, max penetration %.1f cm", tunnelled, states2.size(), 100 * pen),
+          fmt("tunnelled (centre ever below -R, or below 0 at the end) = 0 and max penetration <= 0.25 R "
+              "(%.1f cm)",
+              25 * r2));
+    }
+  }
+}
+
+// 2. large time step -----------------------------------------------------------------------------------
+void Matrix::large_time_step()
+{
+  scenes::DropOptions o;
+  o.count = 50;
+  o.bounding_radius = R();
+  const scenes::DropScene3 scene = scenes::drop_scene3(o);
+  double top = 0, v0 = 0;
+  for (const auto& s : scene.bodies) {
+    top = std::max(top, s.position.z());
+    v0 = std::max(v0, s.linear_velocity.norm());
+  }
+  for (const double hz : {30.0, 15.0}) {
+    const double dt = 1 / hz, T = 10;
+    const int steps = static_cast<int>(std::lround(T / dt));
+    const double bound = 1.25 * (std::sqrt(v0 * v0 + 2 * kG * top) + kG * dt);
+    const std::string name = fmt("large dt 1/%.0f, 50-bunny drop", hz);
+    const std::string criterion =
+        fmt("lost = 0 and max speed <= 1.25 (free-fall speed + g dt) = %.1f m/s", bound);
+    for (const std::string& m : methods3()) {
+      auto sim = make_sim3(body_, m, Setup3{}, scene.bodies);
+      double vmax = 0;
+      for (int k = 0; k < steps; ++k) {
+        sim->step(dt);
+        for (std::size_t i = 0; i < sim->size(); ++i) {
+          const double v = sim->state(i).v.norm();
+          vmax = std::isfinite(v) ? std::max(vmax, v) : kInf;
+        }
+      }
+      int lost = 0;
+      for (std::size_t i = 0; i < sim->size(); ++i) {
+        const State3 s = sim->state(i);
+        lost += !finite3(s.x) || s.x.z() < -R() || std::fabs(s.x.x()) > 50 || std::fabs(s.x.y()) > 50;
+      }
+      add(name, m, lost == 0 && vmax <= bound, fmt("max speed %.2f m/s, lost %d/50", vmax, lost), criterion);
+    }
+  }
+}
+
+// 3. deep pile -----------------------------------------------------------------------------------------
+void Matrix::deep_pile()
+{
+  scenes::DropOptions o;
+  o.count = opt_.quick ? 1000 : 10000;
+  o.bounding_radius = R();
+  const scenes::DropScene3 scene = scenes::drop_scene3(o);
+  Setup3 setup;
+  const double wall = scene.region.radius + R();
+  setup.planes.push_back({Eigen::Vector3d(1, 0, 0), -wall});
+  setup.planes.push_back({Eigen::Vector3d(-1, 0, 0), -wall});
+  setup.planes.push_back({Eigen::Vector3d(0, 1, 0), -wall});
+  setup.planes.push_back({Eigen::Vector3d(0, -1, 0), -wall});
+  const double dt = 1.0 / 60, T = 20;
+  const int steps = static_cast<int>(std::lround(T / dt));
+  const std::string name = fmt("deep pile %d bunnies, 5 planes", o.count);
+  const double ke_per_body = 1e-3;
+  for (const std::string& m : methods3()) {
+    const bool stat = m == "statistical";
+    const std::string criterion =
+        fmt("after 20 s: asleep >= 95%%, kinetic energy <= %.0e J per body, ", ke_per_body) +
+        (stat ? std::string("max sphere overlap <= 20% of the radius sum (each second of the last 5 s)")
+              : fmt("max contact penetration <= 0.2 R = %.1f cm (each second of the last 5 s)", 20 * R()));
+    const Clock::time_point t0 = Clock::now();
+    auto sim = make_sim3(body_, m, setup, scene.bodies);
+    const double build_s = seconds_since(t0);
+    double overlap = 0, overlap_all = 0;
+    int done = 0;
+    double step_s = 0;
+    for (; done < steps; ++done) {
+      const Clock::time_point s0 = Clock::now();
+      sim->step(dt);
+      step_s += seconds_since(s0);
+      // Once per simulated second (the statsim measure visits every pair of bodies).
+      if ((done + 1) % 60 == 0) {
+        const double now = sim->overlap();
+        overlap_all = std::max(overlap_all, now);
+        if ((done + 1) * dt > T - 5) overlap = std::max(overlap, now);
+      }
+      if (!stat && step_s + build_s > budget()) {
+        ++done;
+        break;
+      }
+      if (opt_.progress && (done + 1) % 300 == 0)
+        std::fprintf(stderr, "stress: deep pile %s: %.0f s simulated, %.1f ms/step\n", m.c_str(), (done + 1) * dt,
+                     1e3 * step_s / (done + 1));
+    }
+    std::size_t asleep = 0;
+    for (std::size_t i = 0; i < sim->size(); ++i) asleep += sim->state(i).asleep;
+    const double ke = sim->kinetic_energy();
+    const double frac = double(asleep) / double(sim->size());
+    const double ms = 1e3 * step_s / std::max(done, 1);
+    std::string figure = fmt("KE %.3g J (%.2g J/body), asleep %.1f%%, ", ke, ke / double(sim->size()), 100 * frac) +
+                         (stat ? fmt("max overlap %.1f%% of radius sum (whole run %.1f%%)", 100 * overlap,
+                                     100 * overlap_all)
+                               : fmt("max penetration %.2f cm (whole run %.2f cm)", 100 * overlap,
+                                     100 * overlap_all)) +
+                         fmt(", %.2f ms/step", ms);
+    bool pass = frac >= 0.95 && ke <= ke_per_body * double(sim->size()) && overlap <= (stat ? 0.2 : 0.2 * R());
+    if (done < steps) {
+      figure += fmt("; stopped at %.1f s simulated (budget %.0f s wall)", done * dt, budget());
+      pass = false;
+    }
+    if (stat) {
+      const auto* s = dynamic_cast<const StatsimSim3<16384>*>(sim.get());
+      const auto* s1 = dynamic_cast<const StatsimSim3<1024>*>(sim.get());
+      const std::uint32_t dropped = s ? s->pairs_dropped() : (s1 ? s1->pairs_dropped() : 0);
+      if (dropped) figure += fmt("; pair buffer overflow (up to %u dropped)", dropped);
+    }
+    add(name, m, pass, figure, criterion);
+  }
+}
+
+// 4. energy --------------------------------------------------------------------------------------------
+std::vector<scenes::BodyState3> box_states(int n, double half, double speed, std::uint64_t seed)
+{
+  scenes::SceneRng rng(seed);
+  std::vector<scenes::BodyState3> out;
+  const int side = static_cast<int>(std::ceil(std::cbrt(double(n))));
+  const double cell = 2 * (half - 0.25) / side;
+  for (int k = 0; k < n; ++k) {
+    const int i = k % side, j = (k / side) % side, l = k / (side * side);
+    scenes::BodyState3 s;
+    s.position = Eigen::Vector3d(-half + 0.25 + (i + 0.5) * cell, -half + 0.25 + (j + 0.5) * cell,
+                                 -half + 0.25 + (l + 0.5) * cell);
+    s.orientation = random_q(rng);
+    s.linear_velocity =
+        Eigen::Vector3d(rng.uniform(-speed, speed), rng.uniform(-speed, speed), rng.uniform(-speed, speed));
+    s.angular_velocity = Eigen::Vector3d(rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2));
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<PlaneSpec> closed_box(double half)
+{
+  std::vector<PlaneSpec> p;
+  for (int a = 0; a < 3; ++a)
+    for (const double sgn : {1.0, -1.0}) {
+      Eigen::Vector3d n = Eigen::Vector3d::Zero();
+      n[a] = sgn;
+      p.push_back({n, -half});
+    }
+  return p;
+}
+
+void Matrix::energy()
+{
+  const int n = opt_.quick ? 50 : 100;
+  const int steps = opt_.quick ? 2000 : 10000;
+  const double dt = 1.0 / 60, half = 1.0;
+  const auto states = box_states(n, half, 3.0, 21);
+  Setup3 setup;
+  setup.planes = closed_box(half);
+  setup.gravity = Eigen::Vector3d::Zero();
+  setup.sleeping = false;
+  setup.restitution = 1;
+  setup.friction = 0;
+  const std::string criterion = "kinetic energy never above its start (relative tolerance 1e-5)";
+  auto run = [&](const std::string& scene, const std::string& label, std::unique_ptr<Sim3> sim, bool statsim) {
+    const double ke0 = sim->kinetic_energy();
+    double hi = ke0;
+    int done = 0;
+    const Clock::time_point t0 = Clock::now();
+    for (; done < steps; ++done) {
+      sim->step(dt);
+      const double ke = sim->kinetic_energy();
+      hi = std::isfinite(ke) ? std::max(hi, ke) : kInf;
+      if (!statsim && seconds_since(t0) > budget()) {
+        ++done;
+        break;
+      }
+    }
+    const double ke1 = sim->kinetic_energy();
+    std::string figure = fmt("KE0 %.4g J; max %+.3g%%, end %+.3g%% (drift)", ke0, 100 * (hi / ke0 - 1),
+                             100 * (ke1 / ke0 - 1));
+    bool pass = hi <= ke0 * (1 + 1e-5);
+    if (done < steps) {
+      figure += fmt("; stopped after %d of %d steps (budget)", done, steps);
+      pass = false;
+    }
+    add(scene, label, pass, figure, criterion);
+  };
+  const std::string scene = fmt("energy, elastic box, %d steps", steps);
+  for (const std::string& m : methods3()) {
+    Setup3 s = setup;
+    s.particle = m == "statistical";
+    run(scene, m == "statistical" ? "statistical" : m, make_sim3(body_, m, s, states), m == "statistical");
+  }
+  if (want("statistical"))
+    run(fmt("energy, statistical responses, %d steps", steps), "statistical",
+        make_sim3(body_, "statistical", setup, states), true);
+}
+
+// 5. out-of-range states -------------------------------------------------------------------------------
+void Matrix::out_of_range()
+{
+  const SignatureView<3> sig = tables::bunny.view();
+  const double s_max = double(sig.height.spin_ratio.values[sig.height.spin_ratio.size - 1]);
+  const double L = double(sig.length);
+  struct Case {
+    std::string name;
+    std::vector<scenes::BodyState3> states;
+    double T;
+    double speed_bound;
+    bool at_rest;
+    bool energy = false;  ///< judge by total energy (kinetic with spin + potential), not speed
+  };
+  std::vector<Case> cases;
+  scenes::SceneRng rng(31);
+  {
+    // Speed 10x the fastest impacts of the drop scenes (~10 m/s), spin ratio 100x the table's last.
+    Case c{"spin 100x, speed 10x", {}, 3.0, 0, false};
+    const double v = 100, w = 100 * s_max * v / L;
+    for (int i = 0; i < 9; ++i) {
+      scenes::BodyState3 s;
+      s.position = Eigen::Vector3d((i % 3 - 1) * 6 * R(), (i / 3 - 1) * 6 * R(), 1.0);
+      s.orientation = random_q(rng);
+      const Eigen::Vector3d dir = Eigen::Vector3d(rng.uniform(-1, 1), rng.uniform(-1, 1), -1).normalized();
+      s.linear_velocity = v * dir;
+      s.angular_velocity = w * Eigen::Vector3d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized();
+      c.states.push_back(s);
+    }
+    c.speed_bound = v + kG * c.T;
+    c.energy = true;  // a spinning body may rightly turn spin into speed at an impact
+    c.name += fmt(" (|v| = %.0f m/s, |w| = %.3g rad/s)", v, w);
+    cases.push_back(c);
+  }
+  {
+    Case c{"interpenetrating start (27 at 0.3 R spacing)", {}, 5.0, 0, false};
+    for (int i = 0; i < 27; ++i) {
+      scenes::BodyState3 s;
+      s.position = Eigen::Vector3d((i % 3 - 1) * 0.3 * R(), (i / 3 % 3 - 1) * 0.3 * R(), 1.0 + (i / 9 - 1) * 0.3 * R());
+      s.orientation = random_q(rng);
+      c.states.push_back(s);
+    }
+    c.speed_bound = std::sqrt(2 * kG * 1.2) + 2;
+    cases.push_back(c);
+  }
+  {
+    Case c{"exactly at rest on the ground (each rest pose)", {}, 10.0, 2.0, true};
+    for (std::uint32_t k = 0; k < sig.rest.count; ++k) {
+      scenes::BodyState3 s;
+      const Eigen::Vector3d n = sig.rest.normal(k).cast<double>().normalized();
+      s.orientation = Eigen::Quaterniond::FromTwoVectors(n, Eigen::Vector3d::UnitZ());
+      s.position = Eigen::Vector3d((double(k) - 2) * 5 * R(), 0, 0);  // z per method below
+      c.states.push_back(s);
+    }
+    cases.push_back(c);
+  }
+  {
+    Case c{"two bodies at the same position (x2)", {}, 5.0, 0, false};
+    scenes::BodyState3 a;
+    a.position = Eigen::Vector3d(0, 0, 1);
+    a.orientation = random_q(rng);
+    scenes::BodyState3 b = a;
+    b.position = Eigen::Vector3d(1, 0, 0.1);
+    c.states = {a, a, b, b};
+    c.speed_bound = std::sqrt(2 * kG * 1.2) + 2;
+    cases.push_back(c);
+  }
+  const double dt = 1.0 / 60;
+  for (Case& c : cases) {
+    for (const std::string& m : methods3()) {
+      std::vector<scenes::BodyState3> states = c.states;
+      if (c.at_rest)
+        for (std::size_t k = 0; k < states.size(); ++k)
+          states[k].position.z() = m == "statistical" ? double(sig.rest.heights[k])
+                                                      : -lowest_offset(body_, m, states[k].orientation);
+      auto sim = make_sim3(body_, m, Setup3{}, states);
+      const int steps = static_cast<int>(std::lround(c.T / dt));
+      double vmax = 0, displaced = 0;
+      const double mass = m == "statistical" ? double(sig.mass) : body_.mass;
+      const auto total_energy = [&]() {
+        double e = sim->kinetic_energy();
+        for (std::size_t i = 0; i < sim->size(); ++i) e += mass * kG * sim->state(i).x.z();
+        return e;
+      };
+      const double e0 = total_energy();
+      double emax = e0;
+      int nan = 0;
+      for (int k = 0; k < steps; ++k) {
+        sim->step(dt);
+        for (std::size_t i = 0; i < sim->size(); ++i) {
+          const State3 s = sim->state(i);
+          const double v = s.v.norm();
+          vmax = std::isfinite(v) ? std::max(vmax, v) : kInf;
+        }
+        if (c.energy) {
+          const double e = total_energy();
+          emax = std::isfinite(e) ? std::max(emax, e) : kInf;
+        }
+      }
+      int lost = 0;
+      for (std::size_t i = 0; i < sim->size(); ++i) {
+        const State3 s = sim->state(i);
+        const bool bad = !finite3(s.x) || !finite3(s.v) || !finite3(s.w) || !std::isfinite(s.q.norm());
+        nan += bad;
+        lost += !bad && s.x.z() < -R();
+        if (!bad) displaced = std::max(displaced, (s.x - states[i].position).norm());
+      }
+      std::string figure = fmt("non-finite %d, lost %d, max speed %.3g m/s", nan, lost, vmax);
+      std::string criterion = fmt("no non-finite state, nothing below the ground, max speed <= %.3g m/s",
+                                  c.speed_bound);
+      bool pass = nan == 0 && lost == 0 && vmax <= c.speed_bound;
+      if (c.energy) {
+        figure += fmt(", total energy max %+.3g%% of its start %.4g J", 100 * (emax / e0 - 1), e0);
+        criterion = "no non-finite state, nothing below the ground, total energy (kinetic with spin + potential) "
+                    "never above its start (+0.1%)";
+        pass = nan == 0 && lost == 0 && emax <= e0 * 1.001;
+      }
+      if (c.at_rest) {
+        figure += fmt(", final displacement %.2f cm", 100 * displaced);
+        criterion += ", final displacement <= 0.25 R";
+        pass = pass && displaced <= 0.25 * R();
+      }
+      if (c.name.rfind("two bodies", 0) == 0) {
+        const double sep1 = (sim->state(0).x - sim->state(1).x).norm();
+        const double sep2 = (sim->state(2).x - sim->state(3).x).norm();
+        figure += fmt(", final separations %.3f and %.3f m", sep1, sep2);
+      }
+      add("out of range: " + c.name, m, pass, figure, criterion);
+    }
+  }
+}
+
+// 6. long run ------------------------------------------------------------------------------------------
+void Matrix::long_run()
+{
+  if (!want("statistical")) return;
+  scenes::DropOptions o;
+  o.count = 1000;
+  o.bounding_radius = R();
+  const scenes::DropScene3 scene = scenes::drop_scene3(o);
+  const double dt = 1.0 / 60, T = opt_.quick ? 120.0 : 3600.0, snapshot = 60.0;
+  const long steps = std::lround(T / dt), snap_step = std::lround(snapshot / dt);
+  std::uint64_t hashes[2] = {0, 0};
+  int nan = 0;
+  double sleeper_drift = 0, creep = 0, ms = 0;
+  std::size_t awake_end = 0;
+  for (int run = 0; run < 2; ++run) {
+    StatsimSim3<1024> sim(body_, Setup3{}, scene.bodies);
+    std::vector<Eigen::Vector3d> at_snap;
+    std::vector<bool> slept(sim.size(), false);
+    const Clock::time_point t0 = Clock::now();
+    for (long k = 1; k <= steps; ++k) {
+      sim.step(dt);
+      if (k == snap_step) {
+        for (std::size_t i = 0; i < sim.size(); ++i) {
+          at_snap.push_back(sim.state(i).x);
+          slept[i] = sim.state(i).asleep;
+        }
+      } else if (k > snap_step) {
+        // A body counts as a sleeper if it has been asleep at every step since the snapshot.
+        for (std::size_t i = 0; i < sim.size(); ++i)
+          if (slept[i] && sim.world().body(static_cast<BodyId>(i)).state != MotionState::asleep) slept[i] = false;
+      }
+      if (opt_.progress && k % 36000 == 0)
+        std::fprintf(stderr, "stress: long run %d: %.0f s simulated, %.3f ms/step\n", run + 1, double(k) * dt,
+                     1e3 * seconds_since(t0) / double(k));
+    }
+    ms = 1e3 * seconds_since(t0) / double(steps);
+    hashes[run] = sim.hash();
+    if (run == 0) {
+      for (std::size_t i = 0; i < sim.size(); ++i) {
+        const State3 s = sim.state(i);
+        if (!finite3(s.x) || !finite3(s.v)) {
+          ++nan;
+          continue;
+        }
+        const double d = (s.x - at_snap[i]).norm();
+        creep = std::max(creep, d);
+        if (slept[i]) sleeper_drift = std::max(sleeper_drift, d);
+        awake_end += !s.asleep;
+      }
+    }
+  }
+  add(fmt("long run %.0f s, 1000 bunnies", T), "statistical",
+      nan == 0 && sleeper_drift <= 1e-6 && hashes[0] == hashes[1],
+      fmt("non-finite %d, drift of sleepers %.3g m, largest move since %.0f s %.3g m, awake at end %zu, hashes "
+          "%016llx %s, %.3f ms/step",
+          nan, sleeper_drift, snapshot, creep, awake_end, static_cast<unsigned long long>(hashes[0]),
+          hashes[0] == hashes[1] ? "equal" : "DIFFER", ms),
+      "no non-finite state, bodies asleep since 60 s moved <= 1e-6 m, equal final state hash on two runs");
+}
+
+// 7. bad input -----------------------------------------------------------------------------------------
+template <int D>
+void bad_input_dim(Matrix& mx, const SignatureView<D>& sig, const char* method)
+{
+  using Vec = typename Space<D>::Vec;
+  using Rot = typename Space<D>::Rot;
+  const Scalar nan = std::numeric_limits<Scalar>::quiet_NaN(), inf = std::numeric_limits<Scalar>::infinity();
+  const auto make = [&sig](World<D, 4, 2, 16, 2>& w) {
+    const auto shape = w.add_shape(sig);
+    w.add_plane(Vec::Unit(Space<D>::up_axis), 0);
+    for (int i = 0; i < 3; ++i) {
+      BodyDef<D> b;
+      b.shape = shape.id;
+      b.position = Vec::Unit(Space<D>::up_axis) * Scalar(1 + i);
+      w.add_body(b);
+    }
+    w.step(Scalar(1) / 60);
+  };
+  Rot zero_q, long_q;
+  if constexpr (D == 3) {
+    zero_q = Quaternion(0, 0, 0, 0);
+    long_q = Quaternion(1.01f, 0, 0, 0);
+  } else {
+    zero_q = Rot2{0, 0};
+    long_q = Rot2{1.01f, 0};
+  }
+  struct Case {
+    const char* name;
+    Status expected;
+    std::function<Status(World<D, 4, 2, 16, 2>&)> call;
+  };
+  const auto body_with = [](auto edit) {
+    return [edit](World<D, 4, 2, 16, 2>& w) {
+      BodyDef<D> b;
+      b.position = Vec::Unit(Space<D>::up_axis);
+      edit(b);
+      return w.add_body(b).status;
+    };
+  };
+  std::vector<Case> cases = {
+      {"NaN position", Status::non_finite, body_with([&](BodyDef<D>& b) { b.position[0] = nan; })},
+      {"infinite position", Status::non_finite, body_with([&](BodyDef<D>& b) { b.position[1] = inf; })},
+      {"NaN velocity", Status::non_finite, body_with([&](BodyDef<D>& b) { b.linear_velocity[0] = nan; })},
+      {"infinite velocity", Status::non_finite, body_with([&](BodyDef<D>& b) { b.linear_velocity[0] = -inf; })},
+      {"zero quaternion", Status::zero_quaternion, body_with([&](BodyDef<D>& b) { b.orientation = zero_q; })},
+      {"non-unit quaternion (1.01)", Status::non_unit_quaternion,
+       body_with([&](BodyDef<D>& b) { b.orientation = long_q; })},
+      {"zero mass", Status::invalid_mass, body_with([](BodyDef<D>& b) { b.mass = 0; })},
+      {"negative mass", Status::invalid_mass, body_with([](BodyDef<D>& b) { b.mass = -1; })},
+      {"unknown shape", Status::invalid_shape, body_with([](BodyDef<D>& b) { b.shape = 7; })},
+      {"position beyond limits (1e7 m)", Status::out_of_range,
+       body_with([](BodyDef<D>& b) { b.position[0] = Scalar(1e7); })},
+      {"adding past capacity", Status::capacity_exceeded,
+       [](World<D, 4, 2, 16, 2>& w) {
+         BodyDef<D> b;
+         b.position = Vec::Unit(Space<D>::up_axis) * Scalar(5);
+         w.add_body(b);  // the 4th body fills the pool (not checked: it is a valid call)
+         return w.add_body(b).status;
+       }},
+      {"zero dt", Status::invalid_time_step, [](World<D, 4, 2, 16, 2>& w) { return w.step(0).status; }},
+      {"negative dt", Status::invalid_time_step,
+       [](World<D, 4, 2, 16, 2>& w) { return w.step(-Scalar(1) / 60).status; }},
+      {"NaN dt", Status::invalid_time_step, [&](World<D, 4, 2, 16, 2>& w) { return w.step(nan).status; }},
+      {"infinite dt", Status::invalid_time_step, [&](World<D, 4, 2, 16, 2>& w) { return w.step(inf).status; }},
+      {"plane with zero normal", Status::invalid_plane,
+       [](World<D, 4, 2, 16, 2>& w) { return w.add_plane(Vec::Zero(), 0).status; }},
+      {"plane with NaN normal", Status::invalid_plane,
+       [&](World<D, 4, 2, 16, 2>& w) { return w.add_plane(Vec::Constant(nan), 0).status; }},
+      {"set_velocity NaN", Status::non_finite,
+       [&](World<D, 4, 2, 16, 2>& w) { return w.set_velocity(0, Vec::Constant(nan), Space<D>::zero_spin()); }},
+      {"set_transform zero quaternion", Status::zero_quaternion,
+       [&](World<D, 4, 2, 16, 2>& w) { return w.set_transform(0, Vec::Unit(Space<D>::up_axis), zero_q); }},
+      {"set_velocity unknown body", Status::invalid_body,
+       [](World<D, 4, 2, 16, 2>& w) { return w.set_velocity(9, Vec::Zero(), Space<D>::zero_spin()); }},
+  };
+  for (const Case& c : cases) {
+    auto w = std::make_unique<World<D, 4, 2, 16, 2>>();
+    make(*w);
+    // "Adding past capacity" fills the pool first; compare against the world just before the
+    // rejected call.
+    std::uint64_t before = w->state_hash();
+    std::uint32_t bodies = w->body_count(), planes = w->plane_count();
+    Status got;
+    if (std::string(c.name) == "adding past capacity") {
+      BodyDef<D> b;
+      b.position = Vec::Unit(Space<D>::up_axis) * Scalar(5);
+      w->add_body(b);
+      before = w->state_hash();
+      bodies = w->body_count();
+      BodyDef<D> b2 = b;
+      got = w->add_body(b2).status;
+    } else {
+      got = c.call(*w);
+    }
+    const bool unchanged = w->state_hash() == before && w->body_count() == bodies && w->plane_count() == planes;
+    mx.add(std::string("bad input: ") + c.name, method, got == c.expected && unchanged,
+           fmt("%s, world %s", to_string(got), unchanged ? "unchanged" : "CHANGED"),
+           std::string("rejected with ") + to_string(c.expected) + ", state hash and counts unchanged");
+  }
+}
+
+void Matrix::bad_input()
+{
+  if (want("statistical")) bad_input_dim<3>(*this, tables::bunny.view(), "statistical");
+  if (want("statistical2d")) bad_input_dim<2>(*this, tables::square2d.view(), "statistical2d");
+}
+
+}  // namespace
+
+std::vector<StressCell> run_stress(const StressOptions& options)
+{
+  for (const auto& m : options.methods)
+    if (std::find(kMethods3.begin(), kMethods3.end(), m) == kMethods3.end() &&
+        std::find(kMethods2.begin(), kMethods2.end(), m) == kMethods2.end())
+      throw std::invalid_argument("unknown method '" + m + "' (full, low, spheres7, sphere, statistical, polygon, "
+                                  "statistical2d)");
+  if (!(options.budget_s > 0)) throw std::invalid_argument("--budget must be positive");
+  const std::string dir = options.meshes_dir.empty() ? std::string(STATSIM_STRESS_MESHES_DIR) : options.meshes_dir;
+  Matrix mx(options, bench::load_body3("bunny", dir, false));
+  mx.bad_input();
+  mx.fast_impact();
+  mx.large_time_step();
+  mx.out_of_range();
+  mx.energy();
+  mx.deep_pile();
+  mx.long_run();
+  return mx.take();
+}
+
+std::string stress_json(const std::vector<StressCell>& cells)
+{
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& c : cells)
+    j.push_back({{"scene", c.scene}, {"method", c.method}, {"pass", c.pass}, {"figure", c.figure},
+                 {"criterion", c.criterion}});
+  return j.dump(2) + "\n";
+}
+
+std::string stress_markdown(const std::vector<StressCell>& cells)
+{
+  std::string s = "| scene | method | result | figure | criterion |\n|---|---|---|---|---|\n";
+  for (const auto& c : cells)
+    s += "| " + c.scene + " | " + c.method + " | " + (c.pass ? "pass" : "**FAIL**") + " | " + c.figure + " | " +
+         c.criterion + " |\n";
+  return s;
+}
+
+void register_stress_commands(CLI::App& app)
+{
+  auto opts = std::make_shared<StressOptions>();
+  auto json = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "stress", "Stress matrix: fast impacts, large steps, a deep pile, energy, out-of-range states, a long run and "
+                "bad input, for every method (issue 8)");
+  cmd->add_option("--methods", opts->methods,
+                  "Methods (default all): full, low, spheres7, sphere (Bullet), statistical (statsim 3D), polygon "
+                  "(Box2D), statistical2d (statsim 2D)")
+      ->delimiter(',');
+  cmd->add_option("--json", *json, "Write the cells as JSON to FILE");
+  cmd->add_flag("--quick", opts->quick, "Smaller scenes: 1,000-bunny pile, 2,000 energy steps, 120 s long run");
+  cmd->add_option("--budget", opts->budget_s, "Wall-clock seconds one Bullet cell of the pile or energy scene may take")
+      ->capture_default_str();
+  cmd->add_option("--meshes", opts->meshes_dir, "Directory of bunny.obj, bunny_low.obj, bunny_spheres7.txt");
+  cmd->callback([opts, json]() {
+    const std::vector<StressCell> cells = run_stress(*opts);
+    std::cout << stress_markdown(cells);
+    std::size_t failed = 0, stat_failed = 0;
+    for (const auto& c : cells) {
+      failed += !c.pass;
+      stat_failed += !c.pass && (c.method == "statistical" || c.method == "statistical2d");
+    }
+    std::cout << "\n" << cells.size() << " cells, " << failed << " failed (" << stat_failed << " of them statsim)\n";
+    if (!json->empty()) {
+      std::ofstream out(*json);
+      out << stress_json(cells);
+      if (!out) throw std::runtime_error("cannot write " + *json);
+    }
+  });
+}
+
+}  // namespace statsim::tools

@@ -1,0 +1,44 @@
+// `statsim stress`: the stress matrix of issue 8, scenes where approximate methods fail (fast
+// impacts, large time steps, a deep pile, energy in a closed elastic box, states beyond the
+// table's range, a long run, bad input through the public API) against every method: Bullet's
+// reference representations (full, low, spheres7, sphere) and statsim (statistical) in 3D; Box2D
+// (polygon) and statsim (statistical2d) in 2D where the scene applies. Each cell prints pass or
+// fail, its figure and its pass criterion; --json writes the cells.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace statsim::tools {
+
+struct StressOptions {
+  std::vector<std::string> methods;  ///< empty: all
+  bool quick = false;                ///< smaller scenes and budgets (about a minute)
+  double budget_s = 60.0;            ///< wall-clock budget of one reference-engine cell
+  std::string meshes_dir;            ///< empty: the source tree's tools/meshes
+  bool progress = true;
+};
+
+struct StressCell {
+  std::string scene;      ///< e.g. "fast impact 20 m/s"
+  std::string method;     ///< full, low, spheres7, sphere, statistical, polygon, statistical2d
+  bool pass = false;
+  std::string figure;     ///< the measured figures, one line
+  std::string criterion;  ///< what pass means
+};
+
+/// Runs the matrix. Throws std::runtime_error (missing mesh, ...) or std::invalid_argument.
+std::vector<StressCell> run_stress(const StressOptions& options);
+/// The cells as a JSON array of {scene, method, pass, figure, criterion}.
+std::string stress_json(const std::vector<StressCell>& cells);
+/// The cells as a Markdown table.
+std::string stress_markdown(const std::vector<StressCell>& cells);
+
+/// Adds `statsim stress`.
+void register_stress_commands(CLI::App& app);
+
+}  // namespace statsim::tools
