@@ -156,6 +156,12 @@ struct WorldDef {
   PairResponse pair_response = PairResponse::momentum;
   /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
   bool rest_conditions = true;
+  /// Bodies settling on other bodies (not on the ground) blend their radius to the shape's
+  /// frequency-weighted mean rest height, without choosing a pose or turning. Off (the paper's
+  /// method): they rest on their h_coll spheres, and piles stand too tall (100 squares: 10.7 m
+  /// against Box2D's 7.2 m; on: 7.0 m, but about 15% more steps until all sleep; README,
+  /// "2D signatures and the 2D demo").
+  bool pile_rest = false;
   /// Seconds over which a settling body's radius blends from h_coll to h_rest (and back).
   Scalar rest_blend_time = Scalar(0.15);
   /// Settling bodies are turned toward their rest pose at each ground contact with an angular
@@ -198,6 +204,7 @@ struct Body {
   bool touching;                          ///< touched a plane or body in the last step
   bool on_ground;                         ///< touched a near-horizontal plane in the last step
   std::uint8_t rest_pose;                 ///< chosen rest pose, or `no_rest_pose`
+  bool pile_rest;                         ///< settling on other bodies, blending to the mean h_rest (`WorldDef::pile_rest`)
 };
 
 /// `Body::rest_pose` when no rest pose is chosen.
@@ -223,6 +230,9 @@ struct Shape {
   SignatureView<D> signature;  ///< meaningful when `statistical`
   /// Biases of the rest-pose basins (`rest_basin_biases`), one per rest pose.
   std::array<Scalar, max_rest_poses> rest_bias;
+  /// Frequency-weighted mean of the rest heights, m: the radius a body blends to while it
+  /// settles on other bodies (`WorldDef::pile_rest`).
+  Scalar mean_rest_height;
 };
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
@@ -262,7 +272,7 @@ class WorldCore {
         def.material.rolling_resistance < 0)
       return {Status::invalid_material, 0};
     if (shape_count_ == max_shapes_) return {Status::capacity_exceeded, 0};
-    shapes_[shape_count_] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}};
+    shapes_[shape_count_] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius};
     return {Status::ok, ShapeId(shape_count_++)};
   }
 
@@ -284,7 +294,15 @@ class WorldCore {
       rest_max = sig.rest.heights[i] > rest_max ? sig.rest.heights[i] : rest_max;
     }
     const Scalar radius = rest_max > 0 ? rest_max : sig.height.mean[0];
-    shapes_[shape_count_] = Shape<D>{radius, largest, sig.material, true, sig, {}};
+    // The radius of a body at rest on other bodies: the rest heights weighted by how often the
+    // reference came to rest in each pose.
+    Scalar weighted = 0, weight = 0;
+    for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+      weighted += sig.rest.frequencies[i] * sig.rest.heights[i];
+      weight += sig.rest.frequencies[i];
+    }
+    const Scalar mean_rest = weight > 0 ? weighted / weight : radius;
+    shapes_[shape_count_] = Shape<D>{radius, largest, sig.material, true, sig, {}, mean_rest};
     rest_basin_biases<D>(sig, shapes_[shape_count_].rest_bias.data());
     return {Status::ok, ShapeId(shape_count_++)};
   }
@@ -332,6 +350,7 @@ class WorldCore {
     b.touching = false;
     b.on_ground = false;
     b.rest_pose = no_rest_pose;
+    b.pile_rest = false;
     b.rest_blend = 0;
     entries_[id] = SweepEntry{0, 0, id, 1};
     ++body_count_;
@@ -476,6 +495,7 @@ class WorldCore {
       h.add(std::uint8_t(b.touching));
       h.add(std::uint8_t(b.on_ground));
       h.add(b.rest_pose);
+      h.add(std::uint8_t(b.pile_rest));
     }
     for (std::uint32_t i = 0; i < plane_count_; ++i) {
       h.add_vec(planes_[i].normal);
@@ -641,15 +661,15 @@ class WorldCore {
       const Scalar floor = def_.spin_ratio_speed_floor;
       const Vec v_ref = speed < floor ? Vec(Vec::Unit(0) * floor) : Vec(b.linear_velocity);
       const Scalar r = collision_radius<D>(sig, v_ref, b.angular_velocity, def_.nearest_radius);
-      if (b.rest_pose == no_rest_pose) {
+      if (b.rest_pose == no_rest_pose && !b.pile_rest) {
         b.radius = r;
         continue;
       }
-      const Scalar h = sig.rest.heights[b.rest_pose];
+      const Scalar h = b.rest_pose != no_rest_pose ? sig.rest.heights[b.rest_pose] : shape.mean_rest_height;
       const Scalar blended = r + (h - r) * b.rest_blend;
-      // On the ground the sphere changes size about its lowest point, so a body blending to its
+      // A settling body's sphere changes size about its lowest point, so a body blending to its
       // rest height settles smoothly instead of dropping (paper 3.4).
-      if (b.on_ground) b.position[Space<D>::up_axis] += blended - b.radius;
+      if (b.on_ground || b.pile_rest) b.position[Space<D>::up_axis] += blended - b.radius;
       b.radius = blended;
     }
   }
@@ -965,7 +985,7 @@ class WorldCore {
   /// pose nearest to its orientation and blends its radius toward that pose's height; a body
   /// that speeds up again blends back and forgets the pose; a body briefly off the ground keeps
   /// it.
-  void update_rest_pose(Body<D>& b, bool settling_on_ground, bool fast, Scalar dt)
+  void update_rest_pose(Body<D>& b, bool settling_on_ground, bool settling_on_bodies, bool fast, Scalar dt)
   {
     const Shape<D>& shape = shapes_[b.shape];
     if (!shape.statistical || !def_.rest_conditions || shape.signature.rest.count == 0) return;
@@ -977,10 +997,17 @@ class WorldCore {
         if (pose >= shape.signature.rest.count) return;  // only with a non-finite orientation
         b.rest_pose = std::uint8_t(pose);
       }
+      b.pile_rest = false;
       b.rest_blend = b.rest_blend + step < 1 ? b.rest_blend + step : Scalar(1);
-    } else if (fast && b.rest_pose != no_rest_pose) {
+    } else if (def_.pile_rest && settling_on_bodies && (b.pile_rest || b.rest_pose == no_rest_pose)) {
+      b.pile_rest = true;
+      b.rest_blend = b.rest_blend + step < 1 ? b.rest_blend + step : Scalar(1);
+    } else if (fast && (b.rest_pose != no_rest_pose || b.pile_rest)) {
       b.rest_blend = b.rest_blend - step > 0 ? b.rest_blend - step : Scalar(0);
-      if (b.rest_blend == 0) b.rest_pose = no_rest_pose;
+      if (b.rest_blend == 0) {
+        b.rest_pose = no_rest_pose;
+        b.pile_rest = false;
+      }
     }
   }
 
@@ -1007,7 +1034,7 @@ class WorldCore {
       const Scalar w2 = turning ? Scalar(0) : detail::squared_norm(b.angular_velocity) * r2;
       const Scalar speed2 = v2 > w2 ? v2 : w2;
       const bool settling = b.touching && speed2 < settle2;
-      update_rest_pose(b, settling && b.on_ground, speed2 >= settle2, dt);
+      update_rest_pose(b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt);
       if (!settling) {
         b.state = MotionState::moving;
         b.slow_time = 0;

@@ -62,6 +62,39 @@ TEST_CASE("statistical squares dropped on the ground rest face down at height 0.
   for (int p : poses) CHECK(p > 0);  // random drops reach every side
 }
 
+TEST_CASE("pile rest - a square settled on another square blends to the mean rest height only when asked")
+{
+  // Square 1 falls on square 0, which rests on the ground: with pile_rest off it keeps its h_coll
+  // sphere (over 0.6 m for a unit square at low spin), with pile_rest on it blends to the table's
+  // frequency-weighted mean rest height (0.5 m: all four sides rest at 0.5 m).
+  for (const bool pile_rest : {false, true}) {
+    CAPTURE(pile_rest);
+    WorldDef2 def;
+    def.pile_rest = pile_rest;
+    auto w = std::make_unique<World2<8>>(def);
+    const ShapeId square = w->add_shape(square2d_synthetic.view()).id;
+    REQUIRE(w->add_plane(Vector2(0, 1), 0).ok());
+    BodyDef2 b;
+    b.shape = square;
+    b.position = Vector2(0, 0.6f);
+    REQUIRE(w->add_body(b).ok());
+    b.position = Vector2(0, 2.5f);
+    REQUIRE(w->add_body(b).ok());
+    for (int i = 0; i < 60 * 20 && w->count(MotionState::asleep) < 2; ++i) REQUIRE(w->step(1.0f / 60).ok());
+    REQUIRE(w->count(MotionState::asleep) == 2);
+    const Body2& top = w->body(1);
+    CHECK(top.rest_pose == no_rest_pose);
+    CHECK(top.pile_rest == pile_rest);
+    if (pile_rest) {
+      CHECK(top.radius == doctest::Approx(0.5).epsilon(0.01));
+      // It rests on the lower body's sphere: 0.5 m of ground sphere plus the two radii.
+      CHECK(top.position.y() < 0.5f + 0.5f + 0.5f + 0.02f);
+    } else {
+      CHECK(top.radius > 0.6f);
+    }
+  }
+}
+
 TEST_CASE("statistical cubes rest on a face at half the side - with resting conditions only")
 {
   for (bool rest : {true, false}) {

@@ -190,6 +190,7 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
   m.method = "statsim";
   statsim::WorldDef2 def;
   def.restitution_threshold = sig.restitution_threshold;  // as Box2D's (1 m/s)
+  def.pile_rest = o.pile_rest;
   auto world = std::make_unique<StatWorld>(def);
   if (world->construction_status() != statsim::Status::ok) {
     throw std::runtime_error("statsim world rejected its parameters");
@@ -472,7 +473,8 @@ std::string compare2d_table(const Compare2dResult& r)
   t += "compare2d: " + std::to_string(o.n) + " x " + o.shape + " (table " + r.table + "), " + std::to_string(o.drops) +
        " drops (seeds " + std::to_string(o.seed) + ".." + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops) - 1) +
        ") of " + std::to_string(o.steps) + " steps of " + fmt("%.5g", o.dt) +
-       " s; step times: least of " + std::to_string(o.repeat) + " identical runs, mean over the drops\n";
+       " s; step times: least of " + std::to_string(o.repeat) + " identical runs, mean over the drops" +
+       (o.pile_rest ? "; statsim with pile_rest" : "") + "\n";
   t += "box2d_b: Box2D on seeds " + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops)) + ".." +
        std::to_string(o.seed + static_cast<std::uint64_t>(2 * o.drops) - 1) +
        ", a second sample of the reference: its distances are the noise floor\n";
@@ -554,6 +556,8 @@ void register_compare2d_command(CLI::App& app)
                  "drops seeds as a second reference sample, the noise floor")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
+  c->add_flag("--pile-rest", cmd->options.pile_rest,
+              "statsim: bodies settling on other bodies blend to the mean rest height (WorldDef::pile_rest)");
   c->add_option("--csv", cmd->csv, "Also write one CSV row per method to this file");
   c->callback([cmd]() {
     try {

@@ -23,6 +23,7 @@ struct Compare2dOptions {
   /// Independent drops per method, pooled. One drop of 100 bodies is a noisy sample: Box2D's
   /// own share of tilted bodies ranges from 0.30 to 0.75 between seeds.
   int drops = 10;
+  bool pile_rest = false;        ///< statsim's WorldDef::pile_rest
 };
 
 /// Initial state of one body (both simulations start from these).
