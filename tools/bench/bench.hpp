@@ -1,4 +1,4 @@
-// `statsim bench`: the paper's Table 1 against real engines, in one run (issue 6).
+// `statsim bench`: the paper's Table 1 against real engines, in one run.
 //
 // The scene is the shared "bunny drop" (tools/scenes): N bodies dropped from random states in a
 // cylinder above the ground plane, identical initial states for every method. Methods (3D):

@@ -236,8 +236,8 @@ std::string bench_markdown(const BenchResult& r)
     s += "\n";
   }
 
-  // Goals of issue 6.
-  s += "## Goals (issue 6)\n\n";
+  // The performance goals.
+  s += "## Goals\n\n";
   auto speedup = [&](const std::string& m, const std::string& bp, int n) -> std::optional<double> {
     const BenchCell* c = measured(r, m, bp, n);
     const BenchCell* st = measured(r, "statistical", "sap", n);

@@ -1,4 +1,4 @@
-// `statsim stress` (issue 8): see stress.hpp. Every scene is built from fixed seeds, so a run is
+// `statsim stress`: see stress.hpp. Every scene is built from fixed seeds, so a run is
 // repeatable; wall-clock figures (ms per step) are the only ones that vary between runs.
 //
 // Methods. 3D: full, low, spheres7, sphere = Bullet 3.24 (double precision) with the benchmark's
@@ -1181,7 +1181,7 @@ void register_stress_commands(CLI::App& app)
   auto json = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
       "stress", "Stress matrix: fast impacts, large steps, a deep pile, energy, out-of-range states, a long run and "
-                "bad input, for every method (issue 8)");
+                "bad input, for every method");
   cmd->add_option("--methods", opts->methods,
                   "Methods (default all): full, low, spheres7, sphere (Bullet), statistical (statsim 3D), polygon "
                   "(Box2D), statistical2d (statsim 2D)")

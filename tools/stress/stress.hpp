@@ -1,4 +1,4 @@
-// `statsim stress`: the stress matrix of issue 8, scenes where approximate methods fail (fast
+// `statsim stress`: the stress matrix, scenes where approximate methods fail (fast
 // impacts, large time steps, a deep pile, energy in a closed elastic box, states beyond the
 // table's range, a long run, bad input through the public API) against every method: Bullet's
 // reference representations (full, low, spheres7, sphere) and statsim (statistical) in 3D; Box2D
