@@ -107,6 +107,52 @@ bool particle_response(ContactSide<D> a, ContactSide<D> b, const typename Space<
   return true;
 }
 
+/// The same rule as `particle_response` for two point-like sides (radius 0: statistical bodies,
+/// whose spheres are not their shapes): the impulses do not turn them, and only rolling
+/// resistance slows their spins. The terms of the radii vanish exactly (w x 0 = 0, x + 0 = x), so
+/// the result is bit for bit that of `particle_response` with both radii 0; written out because
+/// it runs for every touching pair of statistical bodies in every contact pass.
+template <int D>
+bool particle_point_response(ContactSide<D> a, ContactSide<D> b, const typename Space<D>::Vec& n, const Material& m,
+                             Scalar restitution_threshold)
+{
+  typename Space<D>::Vec& va = a.velocity;
+  typename Space<D>::Vec& vb = b.velocity;
+  const Scalar inv_mass_a = a.inv_mass, inv_mass_b = b.inv_mass;
+  using Vec = typename Space<D>::Vec;
+  const Vec u = vb - va;
+  const Scalar vn = u.dot(n);
+  const Scalar inv_mass_sum = inv_mass_a + inv_mass_b;
+  if (vn >= 0 || inv_mass_sum <= 0) return false;
+  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
+  const Scalar jn = -(1 + e) * vn / inv_mass_sum;
+  Vec impulse = n * jn;
+  const Vec ut = u - n * vn;
+  const Scalar slip = ut.norm();
+  if (slip > Scalar(0)) {
+    const Scalar jt_stick = slip / inv_mass_sum;
+    const Scalar jt_slide = m.friction * jn;
+    const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
+    impulse -= ut * (jt / slip);
+  }
+  vb += impulse * inv_mass_b;
+  va -= impulse * inv_mass_a;
+  if (m.rolling_resistance > 0) {
+    const Vec rel = vb - va;
+    const Vec rel_t = rel - n * rel.dot(n);
+    const Scalar speed = rel_t.norm();
+    const Scalar cut = m.rolling_resistance * jn * inv_mass_sum;
+    const Scalar f = speed > cut ? 1 - cut / speed : Scalar(0);
+    const Vec mean = (va * inv_mass_b + vb * inv_mass_a) / inv_mass_sum;
+    const Vec mean_t = mean - n * mean.dot(n);
+    va += (va - n * va.dot(n) - mean_t) * (f - 1);
+    vb += (vb - n * vb.dot(n) - mean_t) * (f - 1);
+    if (inv_mass_a > 0) a.spin = a.spin * f;
+    if (inv_mass_b > 0) b.spin = b.spin * f;
+  }
+  return true;
+}
+
 /// Body against a static plane with unit normal `n` (pointing out of the plane, towards the
 /// body). Mass cancels out, so none is needed. The same rule as `particle_response` with a static,
 /// spinless first side and a unit-mass body, written out because resting bodies meet the ground

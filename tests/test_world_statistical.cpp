@@ -6,6 +6,7 @@
 #include "statsim/world3.hpp"
 #include "tables/box.hpp"
 #include "tables/bunny.hpp"
+#include "tables/lshape.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -347,4 +348,45 @@ TEST_CASE("statistical worlds: same seed gives bit-identical steps - the energy 
   }
   CHECK(a->state_hash() != c->state_hash());
   CHECK(a->energy_clamp_count() > 0);  // spin std 0.5 L/|v| makes some samples too energetic
+}
+
+namespace {
+statsim::World3<300> lshape_world;  // static storage: about 80 KB
+}
+
+TEST_CASE("L-shapes that keep a rest pose on top of others fall asleep")
+{
+  // 300 L-shapes dropped from a column (examples/drop_lshapes): one picks a rest pose on the
+  // ground, is then held up by others and can no longer turn into it; it must sleep where it is.
+  using namespace statsim;
+  WorldDef3 def;
+  def.seed = 1;
+  lshape_world.configure(def);
+  const ShapeId shape = lshape_world.add_shape(tables::lshape.view()).id;
+  REQUIRE(lshape_world.add_plane(Vector3(0, 0, 1), 0).ok());
+  Pcg32 rng(1, 0);
+  for (int i = 0; i < 300; ++i) {
+    BodyDef3 b;
+    b.shape = shape;
+    const float a = rng.uniform(0, 6.2831853f);
+    const float r = 0.4f * std::sqrt(rng.uniform());
+    const float z = 0.3f + 0.012f * float(i) + rng.uniform(0, 0.012f);
+    b.position = Vector3(r * std::cos(a), r * std::sin(a), z);
+    const float ax = rng.uniform(-1, 1), ay = rng.uniform(-1, 1), az = rng.uniform(-1, 1);
+    const float angle = rng.uniform(0, 3.14159265f);
+    const Vector3 axis = Vector3(ax, ay, az).norm() > 1e-3f ? Vector3(ax, ay, az).normalized() : Vector3(0, 0, 1);
+    b.orientation = Quaternion(Eigen::AngleAxisf(angle, axis));
+    const float vx = rng.uniform(-0.5f, 0.5f), vy = rng.uniform(-0.5f, 0.5f);
+    b.linear_velocity = Vector3(vx, vy, 0);
+    const float wx = rng.uniform(-5, 5), wy = rng.uniform(-5, 5), wz = rng.uniform(-5, 5);
+    b.angular_velocity = Vector3(wx, wy, wz);
+    REQUIRE(lshape_world.add_body(b).ok());
+  }
+  int steps = 0;
+  while (steps < 1200 && lshape_world.count(MotionState::asleep) < 300) {
+    REQUIRE(lshape_world.step(1.0f / 60).status == Status::ok);
+    ++steps;
+  }
+  MESSAGE("all asleep after ", steps, " steps");
+  CHECK(lshape_world.count(MotionState::asleep) == 300);
 }

@@ -278,6 +278,22 @@ public:
     for (const auto& b : bodies_) k += b->getActivationState() == ISLAND_SLEEPING;
     return k;
   }
+  std::size_t body_count() const override { return bodies_.size(); }
+  scenes::BodyState3 body_state(std::size_t i) const override
+  {
+    const btRigidBody& b = *bodies_[i];
+    const btVector3& p = b.getCenterOfMassPosition();
+    const btQuaternion q = b.getOrientation();
+    const btVector3& v = b.getLinearVelocity();
+    const btVector3& w = b.getAngularVelocity();
+    scenes::BodyState3 s;
+    s.position = Eigen::Vector3d(p.x(), p.y(), p.z());
+    s.orientation = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
+    s.linear_velocity = Eigen::Vector3d(v.x(), v.y(), v.z());
+    s.angular_velocity = Eigen::Vector3d(w.x(), w.y(), w.z());
+    return s;
+  }
+  bool body_asleep(std::size_t i) const override { return bodies_[i]->getActivationState() == ISLAND_SLEEPING; }
   EndState end_state() const override
   {
     EndState e;

@@ -14,6 +14,11 @@
 #include <string>
 #include <vector>
 
+namespace statsim {
+template <int D>
+struct SignatureView;
+}
+
 namespace statsim::tools::bench {
 
 using Clock = std::chrono::steady_clock;
@@ -58,6 +63,21 @@ public:
   virtual EndState end_state() const = 0;
   /// Problems of the last step worth a note in the report (e.g. a full pair buffer); empty if none.
   virtual std::string warning() const { return {}; }
+  /// Number of bodies of the scene (body i is the scene's body i).
+  virtual std::size_t body_count() const { return 0; }
+  /// State of body i now (centre of mass, orientation body to world, velocities in the world
+  /// frame), read between steps for the fidelity measurements (`statsim fidelity`), not timed.
+  virtual scenes::BodyState3 body_state(std::size_t i) const
+  {
+    (void)i;
+    return {};
+  }
+  /// True when body i is asleep (Bullet: deactivated; statsim: MotionState::asleep).
+  virtual bool body_asleep(std::size_t i) const
+  {
+    (void)i;
+    return false;
+  }
 };
 
 /// Material and thresholds every method uses, from the statistical table (or defaults).
@@ -122,6 +142,17 @@ std::uint32_t statsim_capacity();
 bool statsim_has_broad_phase_switch();
 /// The runtime's default broad phase: "grid" or "sap".
 std::string statsim_default_broad_phase();
+/// The statistical table compiled in for `shape` (or the synthetic cube when allowed); false if none.
+bool statsim_table3(const std::string& shape, bool allow_synthetic, SignatureView<3>& out);
+/// WorldDef variations of the statistical methods that `statsim fidelity` compares.
+struct StatsimVariant {
+  bool rest_conditions = true;     ///< WorldDef::rest_conditions
+  bool independent_pairs = false;  ///< WorldDef::pair_response = independent (default: momentum)
+};
+/// A statsim world with any signature (e.g. one loaded at run time); `sig`'s storage must outlive it.
+std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mass, const scenes::DropScene3& scene,
+                                         std::uint64_t seed, double dt, const std::string& broad_phase,
+                                         const StatsimVariant& variant);
 /// `broad_phase`: "" = the runtime's default, "grid" or "sap" (sweep-and-prune).
 std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
                                    const std::string& broad_phase);

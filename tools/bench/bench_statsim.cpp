@@ -149,11 +149,13 @@ public:
 
   template <class Scene>
   StatsimSim(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed, double dt,
-             const std::string& broad_phase)
+             const std::string& broad_phase, const StatsimVariant& variant = {})
       : dt_(static_cast<Scalar>(dt))
   {
     WorldDef<D> def;
     def.seed = seed;
+    def.rest_conditions = variant.rest_conditions;
+    if (variant.independent_pairs) def.pair_response = PairResponse::independent;
     set_broad_phase(def, broad_phase);
     world_ = std::make_unique<WorldT>(def);
     if (world_->construction_status() != Status::ok)
@@ -180,6 +182,25 @@ public:
     e.contacts = last_.contacts;
     return e;
   }
+  std::size_t body_count() const override { return world_->body_count(); }
+  scenes::BodyState3 body_state(std::size_t i) const override
+  {
+    scenes::BodyState3 s;
+    if constexpr (D == 3) {
+      const Body<3>& b = world_->body(static_cast<BodyId>(i));
+      s.position = b.position.template cast<double>();
+      s.orientation = b.orientation.template cast<double>();
+      s.linear_velocity = b.linear_velocity.template cast<double>();
+      s.angular_velocity = b.angular_velocity.template cast<double>();
+    } else {
+      (void)i;
+    }
+    return s;
+  }
+  bool body_asleep(std::size_t i) const override
+  {
+    return world_->body(static_cast<BodyId>(i)).state == MotionState::asleep;
+  }
   std::string warning() const override
   {
     if (worst_dropped_ == 0) return {};
@@ -195,15 +216,15 @@ private:
 
 template <int D, class Scene>
 std::unique_ptr<Sim> make_sized(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed,
-                                double dt, const std::string& broad_phase)
+                                double dt, const std::string& broad_phase, const StatsimVariant& v = {})
 {
   const std::size_t n = scene.bodies.size();
-  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, mass, scene, seed, dt, broad_phase);
-  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, mass, scene, seed, dt, broad_phase);
-  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, mass, scene, seed, dt, broad_phase);
-  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, mass, scene, seed, dt, broad_phase);
-  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, mass, scene, seed, dt, broad_phase);
-  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, mass, scene, seed, dt, broad_phase);
+  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, mass, scene, seed, dt, broad_phase, v);
+  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, mass, scene, seed, dt, broad_phase, v);
+  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, mass, scene, seed, dt, broad_phase, v);
+  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, mass, scene, seed, dt, broad_phase, v);
+  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, mass, scene, seed, dt, broad_phase, v);
+  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, mass, scene, seed, dt, broad_phase, v);
   throw std::runtime_error("statsim bench worlds hold at most " + std::to_string(kCapacity) + " bodies");
 }
 
@@ -273,6 +294,21 @@ std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& 
   const std::optional<Table3> t = table3(body.shape, body.synthetic_table);
   if (!t) throw std::runtime_error("no statistical table for " + body.shape);
   return make_sized<3>(t->view, body.mass, scene, seed, dt, broad_phase);
+}
+
+bool statsim_table3(const std::string& shape, bool allow_synthetic, SignatureView<3>& out)
+{
+  const std::optional<Table3> t = table3(shape, allow_synthetic);
+  if (!t) return false;
+  out = t->view;
+  return true;
+}
+
+std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mass, const scenes::DropScene3& scene,
+                                         std::uint64_t seed, double dt, const std::string& broad_phase,
+                                         const StatsimVariant& variant)
+{
+  return make_sized<3>(sig, mass, scene, seed, dt, broad_phase, variant);
 }
 
 std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,

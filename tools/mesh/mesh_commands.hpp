@@ -14,7 +14,7 @@ class App;
 
 namespace statsim::tools {
 
-/// Adds `mesh` with `info`, `decimate`, `spheres`, `box` and `lshape` to the statsim command.
+/// Adds `mesh` with `info`, `decimate`, `spheres`, `box`, `wedge` and `lshape` to the statsim command.
 void register_mesh_commands(CLI::App& app);
 
 /// `mesh info FILE.obj [--density RHO]`: counts, volume, mass, centre of mass, inertia, principal
@@ -31,6 +31,10 @@ int mesh_spheres(const std::string& in, const std::string& out_file, int count, 
 
 /// `mesh box --size X,Y,Z --out F.obj`.
 int mesh_box(const std::array<double, 3>& size, const std::string& out_file, std::ostream& out, std::ostream& err);
+
+/// `mesh wedge --legs A,B --depth D --out F.obj`: a right triangular prism (shapes.hpp).
+int mesh_wedge(double leg_x, double leg_y, double depth, const std::string& out_file, std::ostream& out,
+               std::ostream& err);
 
 /// `mesh lshape --out F.obj` (the fixed dimensions of shapes.hpp).
 int mesh_lshape(const std::string& out_file, std::ostream& out, std::ostream& err);

@@ -43,6 +43,13 @@ TriMesh make_box(const Eigen::Vector3d& size)
   return extrude({{-h.x(), -h.y()}, {h.x(), -h.y()}, {h.x(), h.y()}, {-h.x(), h.y()}}, 0, h.z());
 }
 
+TriMesh make_wedge(double leg_x, double leg_y, double depth)
+{
+  // The centroid of a triangle is the mean of its corners: (leg_x / 3, leg_y / 3) from the right angle.
+  const double cx = leg_x / 3.0, cy = leg_y / 3.0;
+  return extrude({{-cx, -cy}, {leg_x - cx, -cy}, {-cx, leg_y - cy}}, 0, 0.5 * depth);
+}
+
 TriMesh make_lshape()
 {
   // Profile, counter-clockwise: the foot spans x in [-0.075, 0.125], y in [-0.05, 0]; the upright

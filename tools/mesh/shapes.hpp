@@ -29,6 +29,11 @@ std::array<BoxPart, 2> lshape_boxes();
 /// A closed box of the given full size centred at the origin: 8 vertices, 12 triangles.
 TriMesh make_box(const Eigen::Vector3d& size);
 
+/// A wedge (a right triangular prism): the right triangle with legs `leg_x` along x and `leg_y`
+/// along y, extruded `depth` along z, with its centre of mass (the triangle's centroid, mid-depth)
+/// at the origin; 6 vertices, 8 triangles. Metres. Used as a shape none of the tables were tuned on.
+TriMesh make_wedge(double leg_x, double leg_y, double depth);
+
 /// The L-shape as one closed surface (the two boxes' union, without the shared face): the L
 /// profile in the xy plane extruded along z; 12 vertices, 20 triangles.
 TriMesh make_lshape();

@@ -396,6 +396,7 @@ GatherResult gather(const GatherOptions& options)
       r.height_mean.push_back(s.mean);
       r.height_std.push_back(s.std);
     }
+    r.height_flights = static_cast<long long>(nr * n);
     r.height_seconds = seconds_since(t0);
   }
 
@@ -682,6 +683,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << "// command: " << command << "\n";
   h << "// (run from the repository root; tools/regenerate-tables.sh regenerates every table and diffs it)\n";
   for (const std::string& line : option_lines(r)) h << "// Options: " << line << "\n";
+  for (const std::string& line : r.notes) h << "// Sized: " << line << "\n";
   h << "// Input: " << m.source;
   if (m.source_hash != 0) h << " (FNV-1a 64 " << hex64(m.source_hash) << ")";
   h << ", " << m.body_mesh.vertices.size() << " vertices, " << m.body_mesh.triangles.size() << " triangles\n";
@@ -689,7 +691,9 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << "// Mass properties: volume " << fmt("%.9g", m.mass.volume) << " m^3, mass " << fmt("%.9g", m.mass.mass)
     << " kg, principal moments " << vec3(m.mass.principal_moments, "%.9g") << " kg m^2, bounding radius "
     << fmt("%.9g", m.bounding_radius) << " m (= L of the spin ratios)\n";
-  h << "// Trials: " << r.height_mean.size() * static_cast<std::size_t>(o.height_trials) << " flights, "
+  const long long flights = r.height_flights > 0 ? r.height_flights
+                                                 : static_cast<long long>(r.height_mean.size()) * o.height_trials;
+  h << "// Trials: " << flights << " flights, "
     << r.response_trials << " impacts (" << r.time_limited << " hit the time limit), " << o.rest_drops
     << " rest drops (" << r.unsettled << " did not settle)\n";
   h << "// Rest poses (body-frame up, height, frequency):";
@@ -770,6 +774,7 @@ std::string json_text(const GatherResult& r, const std::string& command)
   j["source_fnv1a64"] = hex64(m.source_hash);
   j["bullet"] = bullet_version();
   j["seed"] = o.seed;
+  if (!r.notes.empty()) j["sizing"] = r.notes;
   j["reference"] = {{"shape", shape_description(r)},
                     {"restitution", o.reference.restitution},
                     {"friction", o.reference.friction},

@@ -97,6 +97,7 @@ struct GatherResult {
   std::string ground;  ///< "box" or "plane"
   // h_coll
   std::vector<double> height_mean, height_std;
+  long long height_flights = 0;  ///< flights run (0: height samples x height_trials)
   // responses
   std::vector<std::vector<double>> axes;  ///< 3 (scaled) or 4 (with speed) axes, in table order
   std::vector<double> response_mean, response_std;  ///< cells x 6, row-major in the axes
@@ -108,6 +109,9 @@ struct GatherResult {
   std::vector<RestPose> rest_rare;  ///< clusters at or below the frequency cut
   int settled = 0, unsettled = 0;
   double mean_settle_time = 0.0;  ///< s of simulation, over the settled drops
+  /// Extra header lines ("// Sized: ..."; "sizing" in the JSON), e.g. how --size-for-scene
+  /// chose the table. Empty for a plain gathering.
+  std::vector<std::string> notes;
   // timings, s
   double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
 };

@@ -2,10 +2,12 @@
 
 #include "common/atomic_file.hpp"
 #include "ref3d/gather.hpp"
+#include "ref3d/sizing.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -44,6 +46,12 @@ struct GatherCommand {
   bool settings_check = false;
   std::vector<double> check_speeds = {0.5, 1, 2, 4, 8};
   int check_trials = 200;
+  // --size-for-scene (tools/ref3d/sizing.hpp)
+  bool size_for_scene = false;
+  double scene_max_speed = 0.0, scene_drop_height = 0.0, scene_gravity = 9.81, scene_min_speed = 0.0;
+  double scene_max_spin = 0.0;
+  double error_budget = 0.05;
+  bool sizing_list_all = false;
   std::ostream* out_stream = &std::cout;
   std::ostream* err_stream = &std::cerr;
 };
@@ -56,8 +64,9 @@ std::string recorded_command(const CLI::App& sub)
   for (const CLI::Option* opt : sub.get_options()) {
     const std::string name = opt->get_name(false, true);
     if (opt->count() == 0 || name.rfind("--", 0) != 0) continue;
-    if (name == "--threads" || name == "--quiet" || name == "--json" || name == "--help") continue;
-    if (opt->get_type_size() == 0) {
+    if (name == "--threads" || name == "--quiet" || name == "--json" || name == "--help" || name == "--sizing-list-all")
+      continue;
+    if (opt->get_type_size() == 0 || opt->get_expected_max() == 0) {  // a flag (CLI11 flags expect 0 values)
       cmd += " " + name;
       continue;
     }
@@ -66,6 +75,78 @@ std::string recorded_command(const CLI::App& sub)
     cmd += " " + name + " " + quote(value);
   }
   return cmd;
+}
+
+// --size-for-scene: gathers the dense table over the scene's range, prints the candidates and
+// returns the smallest within the budget, its header notes saying how it was chosen.
+GatherResult gather_sized(const GatherCommand& c, const GatherOptions& o, std::ostream& out)
+{
+  auto f = [](const char* format, double x) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, x);
+    return std::string(buf);
+  };
+  if ((c.scene_max_speed > 0) == (c.scene_drop_height > 0))
+    throw std::runtime_error("--size-for-scene needs one of --scene-max-speed and --scene-drop-height (positive)");
+  if (!(c.scene_gravity > 0)) throw std::runtime_error("--scene-gravity must be positive");
+  if (!(c.error_budget > 0) || !std::isfinite(c.error_budget)) throw std::runtime_error("--error-budget must be positive");
+  SceneRange scene;
+  std::string speed_source;
+  if (c.scene_drop_height > 0) {
+    scene.max_speed = std::sqrt(2.0 * c.scene_gravity * c.scene_drop_height);
+    speed_source = " (a drop of " + f("%g", c.scene_drop_height) + " m at g = " + f("%g", c.scene_gravity) + " m/s^2)";
+  } else {
+    scene.max_speed = c.scene_max_speed;
+  }
+  // One bounce at the restitution takes the largest speed to about e v_max.
+  scene.min_speed = c.scene_min_speed > 0 ? c.scene_min_speed : o.reference.restitution * scene.max_speed;
+  scene.max_spin = c.scene_max_spin;
+  const ShapeModel model = build_model(o);
+  const double L = model.bounding_radius;
+  const GatherOptions dense_options = scene_dense_options(o, scene, L);
+  const GatherResult dense = gather(dense_options);
+  const DenseTable table = dense_table(dense);
+  SizingOptions so;
+  so.budget = c.error_budget;
+  so.threads = o.threads;
+  const SizingResult s = size_table(table, so);
+  out << sizing_report(table, s, c.sizing_list_all);
+  const Candidate& chosen = s.candidates[s.chosen];
+  const HeightCandidate& hc = s.height_candidates[s.height_chosen];
+  auto count = [](const std::vector<std::vector<double>>& axes) {
+    std::string t;
+    std::size_t cells = 1;
+    for (const auto& a : axes) {
+      t += (t.empty() ? "" : " x ") + std::to_string(a.size());
+      cells *= a.size();
+    }
+    return t + " = " + std::to_string(cells) + " cells";
+  };
+  std::vector<std::string> notes;
+  notes.push_back("sized for a scene (tools/ref3d/sizing.hpp): speeds " + f("%.4g", scene.min_speed) + " to " +
+                  f("%.4g", scene.max_speed) + " m/s" + speed_source + ", spin up to " + f("%.4g", scene.max_spin) +
+                  " rad/s: spin ratios up to " + f("%.4g", scene_max_spin_ratio(scene, L)) + " (L = " + f("%.6g", L) +
+                  " m; axes cut there)");
+  notes.push_back("dense gathering: response " + count(dense.axes) + ", h_coll " +
+                  std::to_string(dense.options.height_ratios.size()) + " samples; " + std::to_string(s.candidates.size()) +
+                  " response and " + std::to_string(s.height_candidates.size()) +
+                  " h_coll candidates cut from it (the trial counts below are the dense gathering's)");
+  notes.push_back("error budget " + f("%g", s.budget) +
+                  " (mean 2-Wasserstein miss of the interpolated response distribution over the dense cells, in "
+                  "units of each cell's spread, sampling noise removed; h_coll: the mean height's miss in units of its "
+                  "spread)");
+  notes.push_back("chosen: response " + std::string(chosen.i16 ? "i16" : "f32") + " error " + f("%.4f", chosen.error) +
+                  " (largest " + f("%.3f", chosen.max_error) + ", with noise " + f("%.4f", chosen.raw_error) +
+                  "), h_coll error " + f("%.4f", hc.error) + " (largest " +
+                  f("%.3f", hc.max_error) + "); table error " + f("%.4f", s.error) + ", " + std::to_string(chosen.bytes) +
+                  " bytes (the dense table at f32: " +
+                  std::to_string(signature_bytes(table.height_axis.size(), [&] {
+                    std::vector<std::size_t> v;
+                    for (const auto& a : table.axes) v.push_back(a.size());
+                    return v;
+                  }(), 6, table.rest_poses, false)) +
+                  ")");
+  return sized_result(dense, s, notes);
 }
 
 void run(const GatherCommand& c, const CLI::App& sub)
@@ -98,7 +179,9 @@ void run(const GatherCommand& c, const CLI::App& sub)
     ensure_writable_directory(parent(c.out));
     if (!c.json.empty()) ensure_writable_directory(parent(c.json));
     const std::string command = recorded_command(sub);
-    const GatherResult r = gather(o);
+    GatherResult r;
+    if (c.size_for_scene) r = gather_sized(c, o, out);
+    else r = gather(o);
     const std::string header = header_text(r, command);
     if (!c.json.empty()) write_file_atomic(c.json, json_text(r, command));
     try {
@@ -191,6 +274,25 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
       ->capture_default_str();
   sub->add_option("--density", o.density, "Density, kg/m^3 (sets the recorded mass only)")->capture_default_str();
   sub->add_flag("--quiet", c->quiet, "No progress on stderr");
+  sub->add_flag("--size-for-scene", c->size_for_scene,
+                "Size the table for a scene (tools/ref3d/sizing.hpp): gather densely over the scene's range (the axes "
+                "given, spin ratios cut at s_max = max spin x L / min speed, paper layout: speeds cut to the range), "
+                "then write the smallest subset table (per-axis sample counts, f32 or i16) whose mean error against "
+                "the dense table, in units of each cell's spread, is within --error-budget; prints the candidates");
+  sub->add_option("--scene-max-speed", c->scene_max_speed, "Scene: largest impact speed, m/s (e.g. 4.4)");
+  sub->add_option("--scene-drop-height", c->scene_drop_height,
+                  "Scene: drop height H, m, instead of --scene-max-speed (largest speed sqrt(2 g H))");
+  sub->add_option("--scene-gravity", c->scene_gravity, "Scene: g for --scene-drop-height, m/s^2")->capture_default_str();
+  sub->add_option("--scene-min-speed", c->scene_min_speed,
+                  "Scene: smallest impact speed that matters, m/s (default: restitution x largest speed, one bounce)");
+  sub->add_option("--scene-max-spin", c->scene_max_spin,
+                  "Scene: largest spin |w|, rad/s, counting the spin impacts give (of the order of |V-| / L), e.g. 20")
+      ->capture_default_str();
+  sub->add_option("--error-budget", c->error_budget,
+                  "Sizing: largest mean error accepted: the miss of the candidate's response distribution against the "
+                  "dense table's, in units of the response's own spread, the gathering's sampling noise removed")
+      ->capture_default_str();
+  sub->add_flag("--sizing-list-all", c->sizing_list_all, "Sizing: print every candidate, not only the improving ones");
   sub->add_flag("--settings-check", c->settings_check,
                 "Print the reference-settings check (a face-down cube at normal incidence) instead of gathering");
   sub->add_flag("--speed-check", c->speed_check,

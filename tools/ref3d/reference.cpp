@@ -277,4 +277,30 @@ DropResult Reference::drop(const RigidState& start, double still_speed, double s
   return r;
 }
 
+struct Reference::Run::World {
+  std::unique_ptr<Reference::Impl::World> w;
+};
+
+Reference::Run::Run() = default;
+Reference::Run::~Run() = default;
+
+std::unique_ptr<Reference::Run> Reference::run(const RigidState& start) const
+{
+  std::unique_ptr<Run> r(new Run());
+  r->world_ = std::make_unique<Run::World>();
+  r->world_->w = impl_->make_world(settings_, ground_, start, settings_.gravity, settings_.rest_rolling_friction);
+  r->dt_ = settings_.dt;
+  return r;
+}
+
+void Reference::Run::step()
+{
+  world_->w->world.stepSimulation(dt_, 0, dt_);
+}
+
+RigidState Reference::Run::state() const
+{
+  return state_of(*world_->w->body);
+}
+
 }  // namespace statsim::tools::ref3d

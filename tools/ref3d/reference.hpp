@@ -86,6 +86,29 @@ public:
   /// `still_time` seconds), or `max_time`.
   DropResult drop(const RigidState& start, double still_speed, double still_time, double max_time) const;
 
+  /// A world of its own with gravity stepped by the caller, for measurements outside the
+  /// gathering (`statsim fidelity --reference gather`): the same Bullet world as drop()'s (same
+  /// settings, ground, gravity and rest rolling friction), one step of settings().dt per step().
+  /// The Reference must outlive it; like drop(), it never deactivates the body.
+  class Run {
+  public:
+    ~Run();
+    Run(const Run&) = delete;
+    Run& operator=(const Run&) = delete;
+    /// Advances by settings().dt.
+    void step();
+    /// The body's state now.
+    RigidState state() const;
+
+  private:
+    friend class Reference;
+    Run();
+    struct World;
+    std::unique_ptr<World> world_;
+    double dt_ = 0.0;
+  };
+  std::unique_ptr<Run> run(const RigidState& start) const;
+
   /// The ground actually used.
   Ground ground() const { return ground_; }
   const ShapeModel& model() const { return model_; }

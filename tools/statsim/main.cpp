@@ -3,6 +3,7 @@
 
 #include "bench/bench.hpp"
 #include "export/export_commands.hpp"
+#include "fidelity/fidelity.hpp"
 #include "mesh/mesh_commands.hpp"
 #include "ref2d/ref2d.hpp"
 #include "ref3d/ref3d.hpp"
@@ -21,6 +22,7 @@ int main(int argc, char** argv)
   statsim::tools::register_render_commands(app);
   statsim::tools::register_export_commands(app);
   statsim::tools::register_stress_commands(app);
+  statsim::tools::fidelity::register_fidelity_commands(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -1,0 +1,391 @@
+// tools/fidelity: the distances of `statsim fidelity`, the JSON signature loader and a tiny
+// end-to-end run of the command.
+#include "fidelity/fidelity.hpp"
+#include "fidelity/metrics.hpp"
+#include "ref3d/ref3d.hpp"
+#include "ref3d/signature_json.hpp"
+
+#include "tables/box.hpp"
+
+#include <CLI/CLI.hpp>
+#include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace statsim::tools;
+using namespace statsim::tools::fidelity;
+
+namespace {
+
+struct TempDir {
+  fs::path path;
+  TempDir()
+  {
+    std::string tmpl = (fs::temp_directory_path() / "statsim-test-fidelity-XXXXXX").string();
+    char* p = ::mkdtemp(tmpl.data());
+    REQUIRE(p != nullptr);
+    path = p;
+  }
+  ~TempDir()
+  {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+std::string read(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<double> sample(std::size_t n, double offset, unsigned salt)
+{
+  // A fixed, irregular sample: fractional parts of multiples of an irrational number.
+  std::vector<double> v;
+  for (std::size_t i = 0; i < n; ++i)
+    v.push_back(offset + std::fmod(0.6180339887498949 * static_cast<double>(i * 7 + salt), 1.0));
+  return v;
+}
+
+int run_cli(const std::vector<std::string>& args)
+{
+  CLI::App app{"test"};
+  app.require_subcommand(1);
+  register_fidelity_commands(app);
+  std::vector<std::string> reversed(args.rbegin(), args.rend());
+  reversed.push_back("fidelity");
+  try {
+    app.parse(reversed);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  return 0;
+}
+
+// Numbers of a generated header's initializer in order: hex floats, and integers (i16 values
+// and the axis count).
+struct HeaderNumbers {
+  std::vector<double> floats;
+  std::vector<long> ints;
+};
+HeaderNumbers header_numbers(const std::string& text)
+{
+  HeaderNumbers n;
+  const std::size_t start = text.find("= {");
+  REQUIRE(start != std::string::npos);
+  std::string body = std::regex_replace(text.substr(start), std::regex("//[^\n]*"), "");
+  const std::regex token("(-?0x[0-9a-fA-Fp.+-]+)f|(-?[0-9]+)u?");
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), token); it != std::sregex_iterator(); ++it) {
+    if ((*it)[1].matched) n.floats.push_back(std::strtod((*it)[1].str().c_str(), nullptr));
+    else n.ints.push_back(std::strtol((*it)[2].str().c_str(), nullptr, 10));
+  }
+  return n;
+}
+
+// The loaded signature's numbers in the generated header's order.
+HeaderNumbers loaded_numbers(const LoadedSignature3& s)
+{
+  HeaderNumbers n;
+  auto add = [&](const std::vector<float>& v) { n.floats.insert(n.floats.end(), v.begin(), v.end()); };
+  add({s.length, s.bounding_radius, s.mass, s.unit_inertia[0], s.unit_inertia[1], s.unit_inertia[2],
+       s.material.restitution, s.material.friction, s.material.rolling_resistance, s.restitution_threshold});
+  n.ints.push_back(static_cast<long>(s.axes.size()));
+  add(s.height_axis);
+  add(s.height_mean);
+  add(s.height_stddev);
+  for (std::size_t a = 0; a < 4; ++a) add(a < s.axes.size() ? s.axes[a] : std::vector<float>{0.0f});
+  if (s.i16) {
+    add({s.mean_scale, s.mean_offset});
+    for (auto q : s.response_mean_q) n.ints.push_back(q);
+    add({s.stddev_scale, s.stddev_offset});
+    for (auto q : s.response_stddev_q) n.ints.push_back(q);
+  } else {
+    add(s.response_mean);
+    add(s.response_stddev);
+  }
+  add(s.rest_normals);
+  add(s.rest_heights);
+  add(s.rest_frequencies);
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("fidelity: distances of identical samples are zero")
+{
+  const std::vector<double> a = sample(50, 0.0, 1);
+  CHECK(w1(a, a) == 0.0);
+  CHECK(ks(a, a) == 0.0);
+  CHECK(tvd({3, 1, 0, 6}, {3, 1, 0, 6}) == 0.0);
+  CHECK(tvd({3, 1, 0, 6}, {6, 2, 0, 12}) == doctest::Approx(0.0));  // same proportions
+}
+
+TEST_CASE("fidelity: analytic values of shifted and disjoint samples")
+{
+  const std::vector<double> a = sample(40, 0.0, 3);
+  std::vector<double> b = a;
+  for (double& x : b) x += 0.25;
+  CHECK(w1(a, b) == doctest::Approx(0.25).epsilon(1e-12));
+  CHECK(ks(a, b) > 0.0);
+  // Disjoint supports: every x between them has F_a = 1, F_b = 0.
+  std::vector<double> c = a;
+  for (double& x : c) x += 5.0;
+  CHECK(ks(a, c) == 1.0);
+  CHECK(w1(a, c) == doctest::Approx(5.0));
+  // Different sizes: W1 of {0} and {0, 1} is 0.5 (half the mass moves by 1).
+  CHECK(w1({0.0}, {0.0, 1.0}) == doctest::Approx(0.5));
+  CHECK(ks({0.0}, {0.0, 1.0}) == doctest::Approx(0.5));
+  CHECK(tvd({1, 0}, {0, 1}) == 1.0);
+  CHECK(tvd({1, 1}, {1, 0}) == doctest::Approx(0.5));
+  CHECK(tvd({}, {}) == 0.0);
+  CHECK(tvd({1}, {}) == 1.0);
+}
+
+TEST_CASE("fidelity: the bootstrap interval of a shift holds the estimate and is deterministic")
+{
+  const std::vector<double> a = sample(200, 0.0, 5);
+  const std::vector<double> b = sample(200, 0.3, 11);
+  auto stat = [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
+    return mean(pick(b, ib)) - mean(pick(a, ia));
+  };
+  const double estimate = stat(iota(a.size()), iota(b.size()));
+  const Interval ci = bootstrap(a.size(), b.size(), stat, 200, 0.90, 7);
+  CHECK(ci.lo <= estimate);
+  CHECK(estimate <= ci.hi);
+  CHECK(ci.lo < ci.hi);
+  const Interval again = bootstrap(a.size(), b.size(), stat, 200, 0.90, 7);
+  CHECK(again.lo == ci.lo);
+  CHECK(again.hi == ci.hi);
+  // W1 of a shifted sample: its interval holds the shift.
+  const Interval w = bootstrap(
+      a.size(), b.size(),
+      [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
+        return w1(pick(a, ia), pick(b, ib));
+      },
+      200);
+  const double point = w1(a, b);
+  CHECK(w.lo <= point);
+  CHECK(point <= w.hi);
+}
+
+TEST_CASE("fidelity: compare gives zero for a sample against itself and more for a changed one")
+{
+  std::vector<DropRun> ref;
+  for (int i = 0; i < 30; ++i) {
+    DropRun r;
+    r.config = i % 3;
+    r.rest_height = 0.4 + 0.01 * (i % 3);
+    r.travel = 0.1 + 0.01 * i;
+    r.bounces = i % 4;
+    r.rest_time = 1.0 + 0.05 * i;
+    r.impact = true;
+    r.impact_speed = 0.5 + 0.02 * i;
+    r.impact_spin = 3.0 + 0.1 * i;
+    ref.push_back(r);
+  }
+  const Distances same = compare(ref, ref, {}, {}, 4, 20);
+  CHECK(same.rest_tvd.value == 0.0);
+  // Heights are equal within each configuration: no deviation from the configuration's mean.
+  CHECK(same.rest_height_err.value == doctest::Approx(0.0).epsilon(1e-12));
+  CHECK(same.travel_w1.value == 0.0);
+  CHECK(same.bounce_w1.value == 0.0);
+  CHECK(same.rest_time_w1.value == 0.0);
+  CHECK(same.first_impact_ks.value == 0.0);
+  CHECK(same.summary_error.value == doctest::Approx(0.0).epsilon(1e-12));
+  std::vector<DropRun> moved = ref;
+  for (DropRun& r : moved) {
+    r.config = 3;  // "other"
+    r.rest_height += 0.05;
+    r.travel += 0.2;
+    r.bounces += 1;
+    r.impact_speed += 10;
+  }
+  const Distances d = compare(moved, ref, {}, {}, 4, 20);
+  CHECK(d.rest_tvd.value == doctest::Approx(1.0));
+  CHECK(d.rest_height_err.value == doctest::Approx(0.05));
+  CHECK(d.travel_w1.value > 0.0);
+  CHECK(d.bounce_w1.value > 0.0);
+  CHECK(d.first_impact_ks_v.value == 1.0);
+  CHECK(d.summary_error.value > 1.0);
+  // Piles: the same piles give zero.
+  PileRun p;
+  p.radius = {0.1, 0.2, 0.3};
+  p.height = {0.06, 0.1, 0.2};
+  p.config = {0, 1, 3};
+  const Distances piles = compare(ref, ref, {p, p}, {p, p}, 4, 20);
+  CHECK(piles.piles);
+  CHECK(piles.pile_radial_w1.value == 0.0);
+  CHECK(piles.pile_height_w1.value == 0.0);
+  CHECK(piles.pile_rest_tvd.value == 0.0);
+}
+
+TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run")
+{
+  TempDir dir;
+  for (const char* precision : {"f32", "i16"}) {
+    CAPTURE(precision);
+    const std::string hpp = dir.file(std::string("tiny_") + precision + ".hpp");
+    const std::string js = dir.file(std::string("tiny_") + precision + ".json");
+    std::ostringstream out, err;
+    const int rc = run_gather_command(
+        {"--shape", "box", "--name", "tinybox", "--cos-theta", "0.5,1", "--cos-phi", "-1,1", "--spin-ratios", "0,1",
+         "--height-ratios", "0,1,4", "--trials", "3", "--height-trials", "8", "--rest-drops", "24", "--threads", "2",
+         "--precision", precision, "--out", hpp, "--json", js, "--quiet"},
+        out, err);
+    INFO(err.str());
+    REQUIRE(rc == 0);
+    const LoadedSignature3 s = load_signature_json(js);
+    CHECK(s.name == "tinybox");
+    CHECK(s.i16 == (std::string(precision) == "i16"));
+    const HeaderNumbers header = header_numbers(read(hpp));
+    const HeaderNumbers loaded = loaded_numbers(s);
+    REQUIRE(header.floats.size() == loaded.floats.size());
+    for (std::size_t i = 0; i < header.floats.size(); ++i) {
+      CAPTURE(i);
+      CHECK(header.floats[i] == loaded.floats[i]);
+    }
+    CHECK(header.ints == loaded.ints);
+    // Equal by construction with the committed table: the same mesh, mass and material.
+    const statsim::SignatureView<3> box = statsim::tables::box.view();
+    CHECK(s.length == box.length);
+    CHECK(s.bounding_radius == box.bounding_radius);
+    CHECK(s.mass == box.mass);
+    CHECK(s.unit_inertia == box.unit_inertia);
+    CHECK(s.material.restitution == box.material.restitution);
+    CHECK(s.material.friction == box.material.friction);
+    CHECK(s.restitution_threshold == box.restitution_threshold);
+    // Bytes as stored: the i16 response tables take half.
+    const std::size_t cells = 2 * 2 * 2, values = cells * 6;
+    const std::size_t fixed = 10 * 4 + 8 + 3 * 3 * 4 + (2 + 2 + 2 + 1) * 4 + s.rest_heights.size() * 5 * 4;
+    CHECK(s.bytes() == fixed + (s.i16 ? 2 * values * 2 + 16 : 2 * values * 4));
+  }
+}
+
+TEST_CASE("fidelity: bad signature JSON is rejected with a message")
+{
+  CHECK_THROWS_WITH_AS(parse_signature_json("{", "x.json"), doctest::Contains("x.json: not valid JSON"),
+                       std::runtime_error);
+  CHECK_THROWS_WITH_AS(parse_signature_json("{\"name\": \"a\"}", "x.json"), doctest::Contains("missing field 'length'"),
+                       std::runtime_error);
+  CHECK_THROWS_AS(load_signature_json("/nonexistent/statsim.json"), std::runtime_error);
+}
+
+TEST_CASE("fidelity: a tiny run writes every key, and the reference against itself is zero")
+{
+  TempDir dir;
+  const std::string json_path = dir.file("fid.json");
+  const std::string chart_path = dir.file("fid.png");
+  const std::string bytes_path = dir.file("bytes.png");
+  // "full" at the reference's own step, with the reference's settings (--reference bench), runs
+  // the reference's drops again: distance 0.
+  REQUIRE(run_cli({"--shape", "box", "--runs", "8", "--no-piles", "--methods", "sphere,statistical,full", "--dt",
+                   "1/120", "--reference-dt", "1/120", "--reference", "bench", "--bench-n", "4",
+                   "--bench-steps", "5", "--bootstrap", "20", "--threads", "2", "--json", json_path, "--chart",
+                   chart_path, "--chart-bytes", bytes_path, "--quiet"}) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read(json_path));
+  REQUIRE(j.contains("methods"));
+  REQUIRE(j.contains("noise_floor"));
+  CHECK(j.at("summary_error_definition").get<std::string>().find("mean of the five") != std::string::npos);
+  const char* keys[] = {"rest_tvd", "rest_height_err", "travel_w1", "bounce_w1", "first_impact_ks", "rest_time_w1",
+                        "summary_error"};
+  for (const char* m : {"sphere", "statistical", "full"}) {
+    CAPTURE(m);
+    REQUIRE(j.at("methods").contains(m));
+    const nlohmann::json& x = j.at("methods").at(m);
+    for (const char* k : keys) {
+      CAPTURE(k);
+      REQUIRE(x.contains(k));
+      CHECK(x.at(k).is_number());
+      const nlohmann::json& ci = x.at(std::string(k) + "_ci");
+      REQUIRE(ci.is_array());
+      REQUIRE(ci.size() == 2);
+      CHECK(ci[0].get<double>() <= ci[1].get<double>());
+    }
+    CHECK(x.at("step_ms").is_number());
+    CHECK(x.contains("table_bytes"));
+  }
+  for (const char* k : keys) CHECK(j.at("noise_floor").contains(k));
+  CHECK(j.at("methods").at("statistical").at("table_bytes").get<long long>() > 0);
+  CHECK(j.at("methods").at("sphere").at("table_bytes").is_null());
+  // The same drops as the reference: every distance is 0, except rest_height_err (and with it
+  // summary_error), which measures heights against the reference's mean height per configuration
+  // and so keeps the reference's own spread about that mean.
+  const nlohmann::json& full = j.at("methods").at("full");
+  for (const char* k : {"rest_tvd", "travel_w1", "bounce_w1", "first_impact_ks", "rest_time_w1"}) {
+    CAPTURE(k);
+    CHECK(full.at(k).get<double>() == 0.0);
+  }
+  CHECK(full.at("summary_error").get<double>() ==
+        doctest::Approx(full.at("rest_height_err").get<double>() / 0.02 / 5));
+  for (const char* k : {"rest_histogram", "mean_travel", "mean_bounces", "mean_rest_time", "mean_rest_height_over_R"})
+    CHECK(full.at("sample").at(k) == j.at("reference").at(k));
+  // The sphere rests on its collision radius, not on a face: its rest height differs.
+  CHECK(j.at("methods").at("sphere").at("rest_height_err").get<double>() > 0.0);
+  CHECK(fs::file_size(chart_path) > 1000);
+  CHECK(j.at("options").at("reference_dt").get<double>() == 1.0 / 120.0);
+  CHECK(j.at("options").at("reference").get<std::string>() == "bench");
+  CHECK(j.at("reference").at("reference").get<std::string>() == "bench");
+  // The bytes chart has one point (statistical); --replot redraws it from the JSON alone.
+  CHECK(fs::file_size(bytes_path) > 1000);
+  const std::string replotted = dir.file("bytes_replot.png");
+  CHECK(run_cli({"--replot", json_path, "--chart-bytes", replotted}) == 0);
+  CHECK(fs::file_size(replotted) > 1000);
+}
+
+TEST_CASE("fidelity: the gathering's reference drops a box to rest on a face")
+{
+  TempDir dir;
+  const std::string json_path = dir.file("gather.json");
+  REQUIRE(run_cli({"--shape", "box", "--runs", "6", "--no-piles", "--methods", "statistical", "--reference",
+                   "gather", "--reference-dt", "1/500", "--no-timing", "--bootstrap", "10", "--threads", "2",
+                   "--json", json_path, "--quiet"}) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read(json_path));
+  CHECK(j.at("options").at("reference").get<std::string>() == "gather");
+  const nlohmann::json& ref = j.at("reference");
+  CHECK(ref.at("reference").get<std::string>() == "gather");
+  REQUIRE(ref.at("settings").is_array());
+  CHECK(ref.at("settings")[0].get<std::string>().find("statsim gather") != std::string::npos);
+  bool has_iterations = false;
+  for (const auto& line : ref.at("settings"))
+    has_iterations |= line.get<std::string>().find("30 solver iterations") != std::string::npos;
+  CHECK(has_iterations);
+  CHECK(j.at("command").get<std::string>().find("--reference gather") != std::string::npos);
+  // Both samples settle, every box on a face: centre at half the side, R / sqrt(3) for a cube,
+  // and no run in "other" (the last configuration).
+  for (const char* sample : {"reference", "reference_b"}) {
+    CAPTURE(sample);
+    const nlohmann::json& x = j.at(sample);
+    CHECK(x.at("time_limited").get<int>() == 0);
+    CHECK(x.at("mean_rest_height_over_R").get<double>() == doctest::Approx(1.0 / std::sqrt(3.0)).epsilon(0.01));
+    CHECK(x.at("rest_histogram").back().get<double>() == 0.0);
+  }
+  CHECK(j.at("noise_floor").at("summary_error").is_number());
+}
+
+TEST_CASE("fidelity: bad options fail before any run")
+{
+  TempDir dir;
+  const std::string json_path = dir.file("bad.json");
+  CHECK(run_cli({"--shape", "box", "--methods", "low", "--runs", "2", "--no-piles", "--quiet", "--json", json_path}) != 0);
+  CHECK(run_cli({"--shape", "box", "--methods", "nonsense", "--quiet"}) != 0);
+  CHECK(run_cli({"--shape", "box", "--dt", "1/0", "--quiet"}) != 0);
+  CHECK(run_cli({"--shape", "box", "--runs", "0", "--quiet"}) != 0);
+  CHECK(run_cli({"--shape", "box", "--reference", "nonsense", "--quiet"}) != 0);
+  CHECK(run_cli({"--mesh", "tools/meshes/box.obj", "--quiet"}) != 0);  // needs --table
+  CHECK(!fs::exists(json_path));
+}

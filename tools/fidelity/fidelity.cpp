@@ -1,0 +1,870 @@
+// `statsim fidelity`: how close each method's outcomes are to the reference's, as distributions.
+//
+// Reference: Bullet "full" (btGImpactMeshShape of the full mesh; btBoxShape / compound of boxes
+// for box and lshape), at --reference-dt (default 1 ms, the gathering's step) in single drops
+// and --pile-reference-dt (default 1/240 s) in piles. Single drops, --reference gather (the
+// default): the Bullet world the tables were gathered in (tools/ref3d's Reference and its
+// ReferenceSettings: 30 iterations, no warm starting, split impulse, margin 0.5 mm, restitution
+// threshold 0.02 m/s; no deactivation: asleep after two 0.25 s windows of average speeds below
+// 0.01 m/s, as the gathering decides rest); the statistics
+// are then compared with the engine set-up the signature describes. --reference bench, and the
+// piles always: the settings of `statsim bench` (tools/bench/bench_bullet.cpp). Both are listed
+// in the report. The methods run at --dt (default 1/60 s,
+// the benchmark's). Noise floor: a second, independent reference sample, compared with the first
+// by the same code.
+//
+// Rest configurations are those of the shape's compiled table (with --mesh: of the first --table,
+// which the methods statistical, statistical-norest and statistical-independent then use).
+// Single drops (--runs N per sample). Run r draws its initial state from its own splitmix64
+// stream seeded with mix(seed, r) (reference sample B: r + 1,000,000): orientation uniform on
+// SO(3) (a uniform point of the unit 4-ball by rejection, normalised); angular velocity
+// components uniform in +-5 rad/s; horizontal velocity components uniform in +-0.5 m/s,
+// vertical 0; centre of mass at x = y = 0 and height uniform in [R + 0.2, R + 1.0] m above the
+// plane z = 0, R the bounding radius. statsim worlds of run r are seeded with the same stream
+// seed. A run ends at rest: the body asleep (Bullet deactivation, statsim MotionState::asleep),
+// or max(|v|, |w| R) < 0.01 m/s for 0.5 s; or at --time-limit (10 s; counted). time_to_rest is
+// the start of the last uninterrupted stretch of steps, ending at rest, in which the body was
+// asleep or slower than 0.01 m/s.
+//  - rest configuration: body-frame up R^T e_z, the nearest rest-pose normal of the signature
+//    by angle, "other" when more than 15 degrees from all. rest_tvd = 0.5 sum |p - p_ref| over
+//    the poses and "other".
+//  - rest_height_err = mean over the method's runs of |z_run - zref(c_run)| / R, zref(c) the
+//    reference's mean rest height in configuration c (its overall mean where it has no run in c).
+//  - travel: horizontal distance from drop point to rest point; travel_w1 = W1 / mean_ref(travel).
+//  - bounces: after the first contact (the first impact below), rises of the centre's height of
+//    at least h = max(0.01 m, 0.05 R) above the lowest height since the last counted rise; after
+//    a rise the centre must fall h below its highest point before the next can count.
+//    bounce_w1 = W1 / mean_ref(bounces) (mean 0: divided by 1); rest_time_w1 likewise.
+//  - first impact: the first step in which the vertical velocity rises by more than 2 |g| dt;
+//    the post-collision state is the state after that step for dt >= 1/60 s, and for smaller dt
+//    after the first later step without such a rise (an impact can span steps). KS statistics of
+//    |v+| and of |w+|; first_impact_ks is the larger. Runs without an impact are left out (counted).
+// Piles: drop_scene3(count = --pile-count, seed s) for s = 1..--pile-seeds (reference floor:
+// seeds pile-seeds+1..2 pile-seeds), run until every body rests (asleep, or slower than
+// 0.01 m/s for 0.5 s) or the time limit. pile_radial_w1: W1 of the bodies' horizontal
+// distances from their pile's centroid, pooled over seeds, / mean_ref; pile_height_w1: W1 of the
+// final centre heights / mean_ref; pile_rest_tvd: rest configurations pooled over bodies.
+// Intervals: percentile bootstrap, --bootstrap (200) resamples of both samples (piles: of the
+// seeds), 90 %, a fixed seed. step_ms: thread CPU time per step on the benchmark scene
+// (drop_scene3, --bench-n bodies, --bench-steps steps at 1/60 s; Bullet with btAxisSweep3), in
+// the same run. summary_error: see summary_error_definition().
+#include "fidelity/fidelity.hpp"
+
+#include "bench/bench_internal.hpp"
+#include "common/parallel.hpp"
+#include "common/progress.hpp"
+#include "mesh/mass.hpp"
+#include "mesh/mesh.hpp"
+#include "ref3d/reference.hpp"
+#include "ref3d/signature_json.hpp"
+#include "scenes/scenes.hpp"
+#include "statsim/signature.hpp"
+#include "statsim/world3.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace statsim::tools::fidelity {
+
+namespace {
+
+constexpr double kGravity = 9.81;
+constexpr double kQuietSpeed = 0.01;   // m/s
+constexpr double kQuietTime = 0.5;     // s
+constexpr double kOtherDegrees = 15.0;
+constexpr double kStillWindow = 0.25;  // s, --reference gather's stillness windows (as the gathering's)
+constexpr std::uint64_t kSampleB = 1000000;  // run-index offset of the second reference sample
+
+// Goals of summary_error.
+constexpr double kGoalTvd = 0.10, kGoalHeight = 0.02, kGoalTravel = 0.20, kGoalBounce = 0.20, kGoalKs = 0.20;
+
+std::uint64_t mix(std::uint64_t seed, std::uint64_t r)
+{
+  std::uint64_t z = seed * 0x9e3779b97f4a7c15ull + r + 0x632be59bd9b4e019ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+std::vector<std::string> default_methods()
+{
+  return {"full", "low", "spheres7", "sphere", "statistical", "statistical-norest", "statistical-independent"};
+}
+
+double summary_error(double rest_tvd, double rest_height_err, double travel_w1, double bounce_w1,
+                     double first_impact_ks)
+{
+  return (rest_tvd / kGoalTvd + rest_height_err / kGoalHeight + travel_w1 / kGoalTravel + bounce_w1 / kGoalBounce +
+          first_impact_ks / kGoalKs) /
+         5.0;
+}
+
+const char* summary_error_definition()
+{
+  return "summary_error is the mean of the five single-drop distances each divided by its goal (rest_tvd/0.10, "
+         "rest_height_err/0.02, travel_w1/0.20, bounce_w1/0.20, first_impact_ks/0.20): 1 = at the goals on average.";
+}
+
+const char* fidelity_definitions()
+{
+  return "Reference: Bullet full (btGImpactMeshShape of the full mesh; boxes for box and lshape) at --reference-dt "
+         "(single drops) and --pile-reference-dt (piles); methods at --dt. Single drops: --reference gather (default) "
+         "uses the Bullet world and settings the tables were gathered with (tools/ref3d: 30 iterations, no warm "
+         "starting, split impulse, margin 0.5 mm, restitution threshold 0.02 m/s; no deactivation: asleep once the average speeds of the centre and "
+         "the farthest point stay below 0.01 m/s over two consecutive 0.25 s windows), --reference bench those of "
+         "statsim bench; piles always use statsim bench's. "
+         "Noise floor: a second independent reference sample (run seeds offset by 1,000,000; pile seeds N+1..2N) "
+         "against the first.\n"
+         "Single drops: run r has its own stream; orientation uniform on SO(3), angular velocity components uniform "
+         "in +-5 rad/s, horizontal velocity components uniform in +-0.5 m/s, centre at x=y=0 and height uniform in "
+         "[R+0.2, R+1.0] m (R: bounding radius). A run ends when the body is asleep or max(|v|,|w|R) < 0.01 m/s for "
+         "0.5 s, or at --time-limit (counted); time_to_rest = start of the last uninterrupted stretch asleep or "
+         "below 0.01 m/s.\n"
+         "rest_tvd: body-frame up R^T e_z, nearest rest-pose normal of the signature (the shape's compiled table, or "
+         "the first --table), 'other' beyond 15 degrees; "
+         "0.5 sum |p - p_ref|. rest_height_err: mean |z - zref(c)| / R, zref(c) the reference's mean rest height in "
+         "configuration c (overall mean if none). travel_w1: W1 of horizontal drop-to-rest distance / reference "
+         "mean. bounce_w1: bounces = rises of the centre of at least max(0.01 m, 0.05 R) above the preceding "
+         "minimum after the first contact (hysteresis), W1 / reference mean (1 if 0); rest_time_w1 likewise. "
+         "first_impact_ks: first step whose vertical velocity rises by more than 2|g|dt; state after it (dt >= "
+         "1/60) or after the next step without such a rise; max of the KS statistics of |v+| and |w+|.\n"
+         "Piles: drop_scene3(--pile-count bodies, seeds 1..N) until all rest or the time limit: W1 of distances from the "
+         "pile centroid / reference mean, W1 of centre heights / reference mean, rest_tvd pooled over bodies.\n"
+         "Intervals: percentile bootstrap, 200 resamples of both samples (piles: seeds), 90%. step_ms: thread CPU "
+         "time per step on the benchmark scene (drop_scene3, --bench-n bodies, --bench-steps steps at 1/60 s).";
+}
+
+// ---- distances -----------------------------------------------------------------------------------
+
+namespace {
+
+std::vector<double> config_histogram(const std::vector<int>& configs, int k)
+{
+  std::vector<double> h(static_cast<std::size_t>(k), 0.0);
+  for (int c : configs)
+    if (c >= 0 && c < k) h[static_cast<std::size_t>(c)] += 1;
+  return h;
+}
+
+template <class F>
+std::vector<double> column(const std::vector<DropRun>& runs, F f)
+{
+  std::vector<double> v;
+  v.reserve(runs.size());
+  for (const DropRun& r : runs) v.push_back(f(r));
+  return v;
+}
+
+double guard(double m)
+{
+  return m > 0 ? m : 1.0;
+}
+
+struct DropStats {
+  double tvd, height, travel, bounce, rest_time, ks_v, ks_w;
+  double ks() const { return std::max(ks_v, ks_w); }
+  double summary() const { return summary_error(tvd, height, travel, bounce, ks()); }
+};
+
+DropStats drop_stats(const std::vector<DropRun>& m, const std::vector<DropRun>& ref, int configs)
+{
+  DropStats s{};
+  std::vector<int> cm, cr;
+  for (const DropRun& r : m) cm.push_back(r.config);
+  for (const DropRun& r : ref) cr.push_back(r.config);
+  s.tvd = tvd(config_histogram(cm, configs), config_histogram(cr, configs));
+
+  // zref(c): the reference's mean rest height per configuration.
+  std::vector<double> zsum(static_cast<std::size_t>(configs), 0.0), zn(static_cast<std::size_t>(configs), 0.0);
+  double all = 0;
+  for (const DropRun& r : ref) {
+    zsum[static_cast<std::size_t>(r.config)] += r.rest_height;
+    zn[static_cast<std::size_t>(r.config)] += 1;
+    all += r.rest_height;
+  }
+  const double overall = ref.empty() ? 0.0 : all / static_cast<double>(ref.size());
+  double err = 0;
+  for (const DropRun& r : m) {
+    const std::size_t c = static_cast<std::size_t>(r.config);
+    const double zref = zn[c] > 0 ? zsum[c] / zn[c] : overall;
+    err += std::fabs(r.rest_height - zref);
+  }
+  // Rest heights are stored in units of R (run_single), so this is the error as a fraction of R.
+  s.height = m.empty() ? 0.0 : err / static_cast<double>(m.size());
+
+  auto travel = [](const DropRun& r) { return r.travel; };
+  auto bounces = [](const DropRun& r) { return r.bounces; };
+  auto rest_time = [](const DropRun& r) { return r.rest_time; };
+  s.travel = w1(column(m, travel), column(ref, travel)) / guard(mean(column(ref, travel)));
+  s.bounce = w1(column(m, bounces), column(ref, bounces)) / guard(mean(column(ref, bounces)));
+  s.rest_time = w1(column(m, rest_time), column(ref, rest_time)) / guard(mean(column(ref, rest_time)));
+  std::vector<double> mv, mw, rv, rw;
+  for (const DropRun& r : m)
+    if (r.impact) mv.push_back(r.impact_speed), mw.push_back(r.impact_spin);
+  for (const DropRun& r : ref)
+    if (r.impact) rv.push_back(r.impact_speed), rw.push_back(r.impact_spin);
+  s.ks_v = ks(mv, rv);
+  s.ks_w = ks(mw, rw);
+  return s;
+}
+
+struct PileStats {
+  double radial, height, tvd;
+};
+
+PileStats pile_stats(const std::vector<PileRun>& m, const std::vector<PileRun>& ref, int configs)
+{
+  std::vector<double> mr, rr, mh, rh;
+  std::vector<int> mc, rc;
+  for (const PileRun& p : m) {
+    mr.insert(mr.end(), p.radius.begin(), p.radius.end());
+    mh.insert(mh.end(), p.height.begin(), p.height.end());
+    mc.insert(mc.end(), p.config.begin(), p.config.end());
+  }
+  for (const PileRun& p : ref) {
+    rr.insert(rr.end(), p.radius.begin(), p.radius.end());
+    rh.insert(rh.end(), p.height.begin(), p.height.end());
+    rc.insert(rc.end(), p.config.begin(), p.config.end());
+  }
+  return {w1(mr, rr) / guard(mean(rr)), w1(mh, rh) / guard(mean(rh)),
+          tvd(config_histogram(mc, configs), config_histogram(rc, configs))};
+}
+
+}  // namespace
+
+Distances compare(const std::vector<DropRun>& method, const std::vector<DropRun>& reference,
+                  const std::vector<PileRun>& method_piles, const std::vector<PileRun>& reference_piles, int configs,
+                  int resamples)
+{
+  Distances d;
+  const DropStats full = drop_stats(method, reference, configs);
+  const std::size_t na = method.size(), nb = reference.size();
+  // One resampling per statistic with the same seed: every statistic sees the same resamples.
+  auto ci = [&](auto get) {
+    return bootstrap(
+        na, nb,
+        [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
+          return get(drop_stats(pick(method, ia), pick(reference, ib), configs));
+        },
+        resamples);
+  };
+  d.rest_tvd = {full.tvd, ci([](const DropStats& s) { return s.tvd; })};
+  d.rest_height_err = {full.height, ci([](const DropStats& s) { return s.height; })};
+  d.travel_w1 = {full.travel, ci([](const DropStats& s) { return s.travel; })};
+  d.bounce_w1 = {full.bounce, ci([](const DropStats& s) { return s.bounce; })};
+  d.rest_time_w1 = {full.rest_time, ci([](const DropStats& s) { return s.rest_time; })};
+  d.first_impact_ks_v = {full.ks_v, ci([](const DropStats& s) { return s.ks_v; })};
+  d.first_impact_ks_w = {full.ks_w, ci([](const DropStats& s) { return s.ks_w; })};
+  d.first_impact_ks = {full.ks(), ci([](const DropStats& s) { return s.ks(); })};
+  d.summary_error = {full.summary(), ci([](const DropStats& s) { return s.summary(); })};
+  if (!method_piles.empty() && !reference_piles.empty()) {
+    d.piles = true;
+    const PileStats p = pile_stats(method_piles, reference_piles, configs);
+    auto pci = [&](auto get) {
+      return bootstrap(
+          method_piles.size(), reference_piles.size(),
+          [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
+            return get(pile_stats(pick(method_piles, ia), pick(reference_piles, ib), configs));
+          },
+          resamples);
+    };
+    d.pile_radial_w1 = {p.radial, pci([](const PileStats& s) { return s.radial; })};
+    d.pile_height_w1 = {p.height, pci([](const PileStats& s) { return s.height; })};
+    d.pile_rest_tvd = {p.tvd, pci([](const PileStats& s) { return s.tvd; })};
+  }
+  return d;
+}
+
+void validate(const FidelityOptions& o)
+{
+  auto bad = [](const std::string& m) { throw std::invalid_argument(m); };
+  if (o.runs < 1) bad("--runs must be at least 1");
+  if (!(o.dt > 0) || o.dt > 0.1) bad("--dt must be in (0, 0.1] s");
+  if (!(o.reference_dt > 0) || o.reference_dt > 0.1) bad("--reference-dt must be in (0, 0.1] s");
+  if (!(o.pile_reference_dt > 0) || o.pile_reference_dt > 0.1) bad("--pile-reference-dt must be in (0, 0.1] s");
+  if (!(o.time_limit > 0) || o.time_limit > 600) bad("--time-limit must be in (0, 600] s");
+  if (o.pile_seeds < 1) bad("--pile-seeds must be at least 1");
+  if (o.pile_count < 1 || o.pile_count > 16384) bad("--pile-count must be in [1, 16384]");
+  if (o.bench_n < 1 || o.bench_n > 16384) bad("--bench-n must be in [1, 16384]");
+  if (o.bench_steps < 1) bad("--bench-steps must be at least 1");
+  if (o.bootstrap < 0) bad("--bootstrap must be >= 0");
+  if (o.reference != "gather" && o.reference != "bench") bad("--reference must be gather or bench");
+  if (!o.mesh.empty() && o.tables.empty()) bad("--mesh needs --table NAME=FILE.json (the shape has no compiled table)");
+  for (const auto& t : o.tables)
+    if (t.first.empty() || t.second.empty()) bad("--table takes NAME=FILE.json");
+}
+
+// ---- running -------------------------------------------------------------------------------------
+
+namespace {
+
+/// What a method is and how to build its world.
+struct MethodSpec {
+  std::string name;
+  std::string description;
+  bool bullet = false;
+  bool gather_reference = false;  // tools/ref3d's Bullet world (single drops only)
+  std::string bullet_method;  // full, low, hull, spheres7, sphere
+  SignatureView<3> table{};
+  bench::StatsimVariant variant;
+  long long table_bytes = -1;
+};
+
+struct Setup {
+  bench::Body3 body;
+  SignatureView<3> poses;  // the signature whose rest poses classify every run
+  std::vector<LoadedSignature3> loaded;
+  std::vector<MethodSpec> methods;
+  double radius = 0;
+  // --reference gather: the shape as the gathering builds it (same body frame as `body`: both
+  // are the mesh's principal frame about its centre of mass) and the gathering's settings.
+  std::unique_ptr<ref3d::ShapeModel> model;
+  ref3d::ReferenceSettings reference_settings;
+};
+
+// The gathering's reference as a bench::Sim of one body (single drops): a Reference of its own,
+// so that nothing (GImpact's lock state included) is shared between threads.
+class GatherReferenceSim final : public bench::Sim {
+public:
+  GatherReferenceSim(const ref3d::ShapeModel& model, const ref3d::ReferenceSettings& settings,
+                     const scenes::BodyState3& start)
+      : reference_(std::make_unique<ref3d::Reference>(model, settings)),
+        radius_(model.bounding_radius),
+        window_(std::max(1L, static_cast<long>(std::ceil(kStillWindow / settings.dt - 1e-9)))),
+        limit_(kQuietSpeed * static_cast<double>(window_) * settings.dt)
+  {
+    ref3d::RigidState s;
+    s.position = start.position;
+    s.orientation = start.orientation;
+    s.velocity = start.linear_velocity;
+    s.spin = start.angular_velocity;
+    run_ = reference_->run(s);
+    anchor_ = s;
+  }
+  // Asleep as the gathering's drop() decides rest: a resting GImpact body jitters by several
+  // mm/s from step to step while going nowhere, so instantaneous speeds stay above 0.01 m/s
+  // now and then; the average speeds of the centre and of the farthest point over each of two
+  // consecutive windows of 0.25 s below kQuietSpeed count instead (like Bullet's deactivation in
+  // the other methods, after 0.5 s of stillness).
+  void step() override
+  {
+    run_->step();
+    if (++steps_ % window_ != 0) return;
+    const ref3d::RigidState s = run_->state();
+    const double moved = (s.position - anchor_.position).norm();
+    const double turned = s.orientation.angularDistance(anchor_.orientation) * radius_;
+    quiet_windows_ = moved < limit_ && turned < limit_ ? quiet_windows_ + 1 : 0;
+    anchor_ = s;
+  }
+  std::size_t asleep() const override { return 0; }
+  bench::EndState end_state() const override
+  {
+    bench::EndState e;
+    e.mean_height = run_->state().position.z();
+    return e;
+  }
+  std::size_t body_count() const override { return 1; }
+  scenes::BodyState3 body_state(std::size_t) const override
+  {
+    const ref3d::RigidState r = run_->state();
+    scenes::BodyState3 s;
+    s.position = r.position;
+    s.orientation = r.orientation;
+    s.linear_velocity = r.velocity;
+    s.angular_velocity = r.spin;
+    return s;
+  }
+  bool body_asleep(std::size_t) const override { return quiet_windows_ >= 2; }
+
+private:
+  std::unique_ptr<ref3d::Reference> reference_;
+  std::unique_ptr<ref3d::Reference::Run> run_;
+  double radius_;
+  long window_;   // steps per stillness window
+  double limit_;  // m of motion per window
+  long steps_ = 0;
+  int quiet_windows_ = 0;
+  ref3d::RigidState anchor_;
+};
+
+// The gathering's reference settings, one per line (as tables/NAME.hpp's header lists them).
+std::vector<std::string> gather_settings_lines(const ref3d::ShapeModel& m, const ref3d::ReferenceSettings& r)
+{
+  char b[600];
+  std::vector<std::string> out;
+  out.push_back("Bullet " + ref3d::bullet_version() +
+                " (double precision) with the settings of statsim gather (tools/ref3d/reference.hpp), one world "
+                "per drop");
+  std::snprintf(b, sizeof b,
+                "dt %.6g s, %d solver iterations, warm starting %s, split impulse %s, erp %.3g, speculative contacts "
+                "%s, multipoint convex-plane manifold %s",
+                r.dt, r.solver_iterations, r.warm_starting ? "on" : "off", r.split_impulse ? "always" : "Bullet's",
+                r.erp, r.speculative_contacts ? "on" : "off", r.multipoint_plane ? "on" : "off");
+  out.push_back(b);
+  std::snprintf(b, sizeof b,
+                "restitution %.3g, friction %.3g (ground 1 and 1: Bullet multiplies), restitution threshold %.3g m/s, "
+                "gravity %.3g m/s^2, rolling friction %.3g m, no deactivation (rest: average speeds of the centre and the farthest point below 0.01 m/s over two consecutive 0.25 s windows)",
+                r.restitution, r.friction, r.restitution_threshold, r.gravity, r.rest_rolling_friction);
+  out.push_back(b);
+  const bool plane = r.ground_auto ? m.kind == ref3d::ShapeKind::mesh : r.ground == ref3d::Ground::plane;
+  const char* body = m.kind == ref3d::ShapeKind::box        ? "btBoxShape"
+                     : m.kind == ref3d::ShapeKind::compound ? "btCompoundShape of btBoxShapes"
+                     : r.mesh_hull                          ? "btConvexHullShape of the mesh's hull"
+                                                            : "btGImpactMeshShape of the full mesh";
+  std::snprintf(b, sizeof b, "body: %s, margin %.3g m, mass %.6g kg; ground: %s", body, r.margin, m.mass.mass,
+                plane ? "btStaticPlaneShape z = 0" : "static btBoxShape, top face z = 0");
+  out.push_back(b);
+  return out;
+}
+
+std::unique_ptr<bench::Sim> build(const Setup& setup, const MethodSpec& m, const scenes::DropScene3& scene,
+                                  std::uint64_t seed, double dt)
+{
+  if (m.gather_reference) {
+    // make_setup() builds the model whenever a method uses it; single drops only (one body).
+    ref3d::ReferenceSettings settings = setup.reference_settings;
+    settings.dt = dt;
+    return std::make_unique<GatherReferenceSim>(*setup.model, settings, scene.bodies[0]);
+  }
+  if (m.bullet) {
+    // Shapes per world: GImpact shapes keep mutable lock state, so worlds on different threads
+    // must not share them.
+    return bench::make_bullet(bench::make_bullet_shapes(setup.body), m.bullet_method, "sap", scene, dt);
+  }
+  return bench::make_statsim3_table(m.table, setup.body.mass, scene, seed, dt, "", m.variant);
+}
+
+int classify(const Eigen::Quaterniond& q, const SignatureView<3>& sig)
+{
+  const Eigen::Vector3d up = q.normalized().toRotationMatrix().transpose() * Eigen::Vector3d::UnitZ();
+  const double cos_other = std::cos(kOtherDegrees * M_PI / 180.0);
+  int best = -1;
+  double best_dot = -2;
+  for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+    const Eigen::Vector3d n(double(sig.rest.normals[3 * i]), double(sig.rest.normals[3 * i + 1]),
+                            double(sig.rest.normals[3 * i + 2]));
+    const double d = up.dot(n.normalized());
+    if (d > best_dot) best_dot = d, best = static_cast<int>(i);
+  }
+  return best >= 0 && best_dot >= cos_other ? best : static_cast<int>(sig.rest.count);
+}
+
+scenes::BodyState3 drop_state(std::uint64_t stream, double radius)
+{
+  scenes::SceneRng rng(stream);
+  double w, x, y, z, n2;
+  do {
+    w = rng.uniform(-1, 1), x = rng.uniform(-1, 1), y = rng.uniform(-1, 1), z = rng.uniform(-1, 1);
+    n2 = w * w + x * x + y * y + z * z;
+  } while (n2 > 1 || n2 < 1e-6);
+  const double inv = 1.0 / std::sqrt(n2);
+  scenes::BodyState3 s;
+  s.orientation = Eigen::Quaterniond(w * inv, x * inv, y * inv, z * inv);
+  s.angular_velocity = Eigen::Vector3d(rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5));
+  s.linear_velocity = Eigen::Vector3d(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), 0.0);
+  s.position = Eigen::Vector3d(0, 0, rng.uniform(radius + 0.2, radius + 1.0));
+  return s;
+}
+
+double speed(const scenes::BodyState3& s, double radius)
+{
+  return std::max(s.linear_velocity.norm(), s.angular_velocity.norm() * radius);
+}
+
+DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream, double dt, double limit)
+{
+  const double R = setup.radius;
+  scenes::DropScene3 scene;
+  scene.options.count = 1;
+  scene.options.bounding_radius = R;
+  scene.bodies.push_back(drop_state(stream, R));
+  scene.bounds_lo = Eigen::Vector3d(-50, -50, -1);
+  scene.bounds_hi = Eigen::Vector3d(50, 50, 10);
+  std::unique_ptr<bench::Sim> sim = build(setup, m, scene, stream, dt);
+
+  DropRun out;
+  const scenes::BodyState3 start = scene.bodies[0];
+  scenes::BodyState3 prev = sim->body_state(0);
+  const double rise = 2 * kGravity * dt;
+  const bool coarse = dt >= 1.0 / 60.0 - 1e-12;
+  const double hysteresis = std::max(0.01, 0.05 * R);
+  bool contact = false, pending = false, rising = false;
+  double low = 0, high = 0;
+  double still_since = -1, quiet_since = -1;
+  const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));
+  scenes::BodyState3 s = prev;
+  double t = 0;
+  bool rested = false;
+  for (long k = 1; k <= steps; ++k) {
+    sim->step();
+    t = static_cast<double>(k) * dt;
+    s = sim->body_state(0);
+    const bool up_kick = s.linear_velocity.z() - prev.linear_velocity.z() > rise;
+    if (!contact && up_kick) {
+      contact = true;
+      low = s.position.z();
+      if (coarse) {
+        out.impact = true, out.impact_speed = s.linear_velocity.norm(), out.impact_spin = s.angular_velocity.norm();
+      } else {
+        pending = true;
+      }
+    } else if (pending && !up_kick) {
+      pending = false;
+      out.impact = true, out.impact_speed = s.linear_velocity.norm(), out.impact_spin = s.angular_velocity.norm();
+    }
+    if (contact) {
+      const double z = s.position.z();
+      if (!rising) {
+        low = std::min(low, z);
+        if (z >= low + hysteresis) rising = true, high = z, out.bounces += 1;
+      } else {
+        high = std::max(high, z);
+        if (z <= high - hysteresis) rising = false, low = z;
+      }
+    }
+    const bool asleep = sim->body_asleep(0);
+    const bool quiet = speed(s, R) < kQuietSpeed;
+    if (asleep || quiet) {
+      if (still_since < 0) still_since = t;
+    } else {
+      still_since = -1;
+    }
+    if (quiet) {
+      if (quiet_since < 0) quiet_since = t;
+    } else {
+      quiet_since = -1;
+    }
+    prev = s;
+    if (asleep || (quiet_since >= 0 && t - quiet_since >= kQuietTime - 1e-9)) {
+      rested = true;
+      break;
+    }
+  }
+  out.time_limited = !rested;
+  out.rest_time = rested ? still_since : t;
+  out.config = classify(s.orientation, setup.poses);
+  out.rest_height = s.position.z() / R;
+  out.travel = std::hypot(s.position.x() - start.position.x(), s.position.y() - start.position.y());
+  return out;
+}
+
+PileRun run_pile(const Setup& setup, const MethodSpec& m, std::uint64_t seed, int count, double dt, double limit,
+                 std::uint64_t world_seed)
+{
+  scenes::DropOptions o;
+  o.count = count;
+  o.bounding_radius = setup.radius;
+  o.seed = seed;
+  const scenes::DropScene3 scene = scenes::drop_scene3(o);
+  std::unique_ptr<bench::Sim> sim = build(setup, m, scene, world_seed, dt);
+  const std::size_t n = scene.bodies.size();
+  std::vector<double> quiet_since(n, -1);
+  const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));
+  PileRun out;
+  out.time_limited = true;
+  std::vector<scenes::BodyState3> s(n);
+  double t = 0;
+  for (long k = 1; k <= steps; ++k) {
+    sim->step();
+    t = static_cast<double>(k) * dt;
+    bool all = true;
+    for (std::size_t i = 0; i < n; ++i) {
+      s[i] = sim->body_state(i);
+      if (speed(s[i], setup.radius) < kQuietSpeed) {
+        if (quiet_since[i] < 0) quiet_since[i] = t;
+      } else {
+        quiet_since[i] = -1;
+      }
+      const bool rest = sim->body_asleep(i) || (quiet_since[i] >= 0 && t - quiet_since[i] >= kQuietTime - 1e-9);
+      all = all && rest;
+    }
+    if (all) {
+      out.time_limited = false;
+      break;
+    }
+  }
+  out.seconds = t;
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const auto& b : s) c += b.position.head<2>();
+  c /= static_cast<double>(n);
+  for (const auto& b : s) {
+    out.radius.push_back((b.position.head<2>() - c).norm());
+    out.height.push_back(b.position.z());
+    out.config.push_back(classify(b.orientation, setup.poses));
+  }
+  return out;
+}
+
+double measure_step_ms(const Setup& setup, const MethodSpec& m, int n, int steps)
+{
+  scenes::DropOptions o;
+  o.count = n;
+  o.bounding_radius = setup.radius;
+  o.seed = 1;
+  const scenes::DropScene3 scene = scenes::drop_scene3(o);
+  std::unique_ptr<bench::Sim> sim = build(setup, m, scene, 1, 1.0 / 60.0);
+  const double t0 = bench::thread_cpu_ms();
+  for (int k = 0; k < steps; ++k) sim->step();
+  return (bench::thread_cpu_ms() - t0) / steps;
+}
+
+bench::Body3 body_from_mesh(const std::string& path, const SignatureView<3>& table)
+{
+  TriMesh mesh;
+  MeshError error;
+  if (!load_obj(path, mesh, error)) throw std::runtime_error(error.message);
+  const MassProperties mp = compute_mass_properties(mesh, 1.0);
+  bench::Body3 body;
+  body.shape = std::filesystem::path(path).stem().string();
+  for (const auto& p : mesh.vertices) {
+    body.full_vertices.push_back(mp.principal_axes.transpose() * (p - mp.com));
+    body.bounding_radius = std::max(body.bounding_radius, body.full_vertices.back().norm());
+  }
+  for (const auto& t : mesh.triangles) body.full_indices.insert(body.full_indices.end(), t.begin(), t.end());
+  body.mass = double(table.mass);
+  body.inertia = mp.principal_moments * (body.mass / mp.volume);
+  body.sphere_radius = double(table.height.mean[0]);
+  body.sphere_radius_note = "the loaded table's mean collision radius h_coll at spin ratio 0";
+  const WorldDef<3> def{};
+  body.surface.restitution = double(table.material.restitution);
+  body.surface.friction = double(table.material.friction);
+  body.surface.rolling_resistance = double(table.material.rolling_resistance);
+  body.surface.restitution_threshold = double(def.restitution_threshold);
+  body.surface.sleep_speed = double(def.sleep_speed);
+  body.surface.sleep_time = double(def.sleep_time);
+  body.has_table = true;
+  body.table_name = "loaded";
+  return body;
+}
+
+Setup make_setup(const FidelityOptions& o)
+{
+  Setup s;
+  // No reallocation after a view is taken: views point into the tables' strings and vectors.
+  s.loaded.reserve(o.tables.size());
+  for (const auto& t : o.tables) {
+    s.loaded.push_back(load_signature_json(t.second));
+    s.loaded.back().name = t.first;
+  }
+  SignatureView<3> compiled{};
+  bool have_compiled = false;
+  if (o.mesh.empty()) {
+    s.body = bench::load_body3(o.shape, o.meshes_dir, o.allow_synthetic);
+    have_compiled = bench::statsim_table3(o.shape, o.allow_synthetic, compiled);
+    if (!have_compiled && s.loaded.empty())
+      throw std::runtime_error("no statistical table for " + o.shape + " (generate tables/" + o.shape +
+                               ".hpp or pass --table NAME=FILE.json)");
+  } else {
+    s.body = body_from_mesh(o.mesh, s.loaded.front().view());
+  }
+  s.radius = s.body.bounding_radius;
+  if (o.reference == "gather") {
+    // The gathering's defaults (tables/NAME.hpp's header lists them) at the body's density.
+    const std::string shape = o.mesh.empty() ? o.shape : std::string();
+    s.model = std::make_unique<ref3d::ShapeModel>(ref3d::load_shape_model(shape, o.mesh, 1000.0));
+    if (std::abs(s.model->mass.mass - s.body.mass) > 1e-9 * s.body.mass)
+      *s.model = ref3d::load_shape_model(shape, o.mesh, 1000.0 * s.body.mass / s.model->mass.mass);
+  }
+  s.poses = have_compiled ? compiled : s.loaded.front().view();
+  const SignatureView<3> base = have_compiled ? compiled : s.loaded.front().view();
+  const long long base_bytes =
+      have_compiled ? static_cast<long long>(signature_bytes(compiled)) : static_cast<long long>(s.loaded.front().bytes());
+  const std::string base_name = have_compiled ? s.body.table_name : s.loaded.front().path;
+
+  const std::vector<std::string> names = o.methods.empty() ? default_methods() : o.methods;
+  auto shapes = bench::make_bullet_shapes(s.body);
+  for (const std::string& name : names) {
+    MethodSpec m;
+    m.name = name;
+    if (name == "full" || name == "low" || name == "hull" || name == "spheres7" || name == "sphere") {
+      std::string why;
+      if (!bench::bullet_supports(*shapes, name, why)) {
+        if (o.methods.empty()) continue;  // the default list keeps what the shape supports
+        throw std::invalid_argument("method " + name + ": " + why);
+      }
+      m.bullet = true;
+      m.bullet_method = name;
+      m.description = "Bullet " + name;
+    } else if (name == "statistical" || name == "statistical-norest" || name == "statistical-independent") {
+      m.table = base;
+      m.table_bytes = base_bytes;
+      m.variant.rest_conditions = name != "statistical-norest";
+      m.variant.independent_pairs = name == "statistical-independent";
+      m.description = "statsim, " + base_name +
+                      (name == "statistical-norest" ? ", resting conditions off"
+                       : name == "statistical-independent" ? ", independent pair response"
+                                                           : ", momentum pair response, resting conditions on");
+    } else if (name.rfind("statistical:", 0) == 0) {
+      const std::string t = name.substr(12);
+      auto it = std::find_if(s.loaded.begin(), s.loaded.end(), [&](const LoadedSignature3& l) { return l.name == t; });
+      if (it == s.loaded.end()) throw std::invalid_argument("method " + name + ": no --table " + t + "=FILE.json");
+      m.table = it->view();
+      m.table_bytes = static_cast<long long>(it->bytes());
+      m.description = "statsim, " + it->path + (it->i16 ? " (i16)" : " (f32)");
+    } else {
+      throw std::invalid_argument("unknown method '" + name +
+                                  "' (full, low, hull, spheres7, sphere, statistical, statistical-norest, "
+                                  "statistical-independent, statistical:NAME)");
+    }
+    s.methods.push_back(m);
+  }
+  // Every loaded table is compared even when not named in --methods.
+  for (const LoadedSignature3& l : s.loaded) {
+    const std::string name = "statistical:" + l.name;
+    if (std::none_of(s.methods.begin(), s.methods.end(), [&](const MethodSpec& m) { return m.name == name; })) {
+      MethodSpec m;
+      m.name = name;
+      m.table = l.view();
+      m.table_bytes = static_cast<long long>(l.bytes());
+      m.description = "statsim, " + l.path + (l.i16 ? " (i16)" : " (f32)");
+      s.methods.push_back(m);
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+FidelityResult run_fidelity(const FidelityOptions& options)
+{
+  validate(options);
+  const auto t_start = std::chrono::steady_clock::now();
+  // The methods' views point into the loaded tables, which a move of the Setup (its vector
+  // moved whole) leaves in place.
+  const std::unique_ptr<Setup> setup = std::make_unique<Setup>(make_setup(options));
+
+  FidelityResult res;
+  res.options = options;
+  res.shape = options.mesh.empty() ? options.shape : options.mesh;
+  res.bounding_radius = setup->radius;
+  for (std::uint32_t i = 0; i < setup->poses.rest.count; ++i) {
+    char b[160];
+    std::snprintf(b, sizeof b, "(%.3f, %.3f, %.3f) %.4f m", double(setup->poses.rest.normals[3 * i]),
+                  double(setup->poses.rest.normals[3 * i + 1]), double(setup->poses.rest.normals[3 * i + 2]),
+                  double(setup->poses.rest.heights[i]));
+    res.pose_labels.push_back(b);
+  }
+  res.pose_labels.push_back("other");
+  const int configs = static_cast<int>(res.pose_labels.size());
+  const bool gather_ref = options.reference == "gather";
+  if (gather_ref) {
+    res.settings = gather_settings_lines(*setup->model, setup->reference_settings);
+    if (options.piles)
+      for (const std::string& line : bench::bullet_settings(setup->body))
+        res.settings.push_back("piles (statsim bench's settings): " + line);
+  } else {
+    res.settings = bench::bullet_settings(setup->body);
+  }
+
+  // Single drops' reference; the piles' is always Bullet full with statsim bench's settings.
+  MethodSpec ref;
+  ref.name = "reference";
+  ref.bullet = true;
+  ref.gather_reference = gather_ref;
+  ref.bullet_method = "full";
+  ref.description = "Bullet full";
+  MethodSpec pile_ref = ref;
+  pile_ref.gather_reference = false;
+  const std::string which = gather_ref ? "Bullet full, statsim gather's settings" : "Bullet full, statsim bench's settings";
+  res.reference.name = "reference";
+  res.reference.description = which + ", sample A";
+  res.reference.dt = options.reference_dt;
+  res.reference_b = res.reference;
+  res.reference_b.description = which + ", sample B (noise floor)";
+
+  // Every single drop is one job: (sample, run). Sample 0 and 1: the references; then the methods.
+  const std::size_t runs = static_cast<std::size_t>(options.runs);
+  const std::size_t samples = 2 + setup->methods.size();
+  const unsigned threads = resolve_thread_count(options.threads);
+  {
+    Progress progress("fidelity: single drops", samples * runs, options.progress);
+    const std::vector<DropRun> all = parallel_map(
+        samples * runs,
+        [&](std::size_t job) {
+          // Interleave: job j is run j / samples of sample j % samples, so that the expensive
+          // reference runs spread over the whole job list.
+          const std::size_t sample = job % samples, r = job / samples;
+          const MethodSpec& m = sample < 2 ? ref : setup->methods[sample - 2];
+          const double dt = sample < 2 ? options.reference_dt : options.dt;
+          const std::uint64_t index = r + (sample == 1 ? kSampleB : 0);
+          DropRun d = run_single(*setup, m, mix(options.seed, index), dt, options.time_limit);
+          progress.add();
+          return d;
+        },
+        threads);
+    res.methods.resize(setup->methods.size());
+    for (std::size_t job = 0; job < all.size(); ++job) {
+      const std::size_t sample = job % samples;
+      MethodResult& mr = sample == 0 ? res.reference : sample == 1 ? res.reference_b : res.methods[sample - 2];
+      mr.drops.push_back(all[job]);
+    }
+  }
+  for (std::size_t i = 0; i < setup->methods.size(); ++i) {
+    res.methods[i].name = setup->methods[i].name;
+    res.methods[i].description = setup->methods[i].description;
+    res.methods[i].dt = options.dt;
+    res.methods[i].table_bytes = setup->methods[i].table_bytes;
+  }
+
+  if (options.piles) {
+    const std::size_t seeds = static_cast<std::size_t>(options.pile_seeds);
+    Progress progress("fidelity: piles", samples * seeds, options.progress);
+    const std::vector<PileRun> all = parallel_map(
+        samples * seeds,
+        [&](std::size_t job) {
+          const std::size_t sample = job % samples, k = job / samples;
+          const MethodSpec& m = sample < 2 ? pile_ref : setup->methods[sample - 2];
+          const double dt = sample < 2 ? options.pile_reference_dt : options.dt;
+          const std::uint64_t seed = 1 + k + (sample == 1 ? seeds : 0);
+          PileRun p = run_pile(*setup, m, seed, options.pile_count, dt, options.time_limit, mix(options.seed, seed));
+          progress.add();
+          return p;
+        },
+        threads);
+    for (std::size_t job = 0; job < all.size(); ++job) {
+      const std::size_t sample = job % samples;
+      MethodResult& mr = sample == 0 ? res.reference : sample == 1 ? res.reference_b : res.methods[sample - 2];
+      mr.piles.push_back(all[job]);
+    }
+  }
+
+  {
+    Progress progress("fidelity: bootstrap", samples - 1, options.progress);
+    res.noise_floor = compare(res.reference_b.drops, res.reference.drops, res.reference_b.piles, res.reference.piles,
+                              configs, options.bootstrap);
+    progress.add();
+    std::vector<Distances> d = parallel_map(
+        res.methods.size(),
+        [&](std::size_t i) {
+          Distances x = compare(res.methods[i].drops, res.reference.drops, res.methods[i].piles, res.reference.piles,
+                                configs, options.bootstrap);
+          progress.add();
+          return x;
+        },
+        threads);
+    for (std::size_t i = 0; i < d.size(); ++i) res.methods[i].d = d[i];
+  }
+
+  if (options.timing) {
+    // One method at a time on this thread: thread CPU time is what the benchmark reports.
+    Progress progress("fidelity: step time", setup->methods.size(), options.progress);
+    for (std::size_t i = 0; i < setup->methods.size(); ++i) {
+      res.methods[i].step_ms = measure_step_ms(*setup, setup->methods[i], options.bench_n, options.bench_steps);
+      progress.add();
+    }
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return res;
+}
+
+}  // namespace statsim::tools::fidelity

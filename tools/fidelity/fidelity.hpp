@@ -1,0 +1,152 @@
+// `statsim fidelity`: accuracy against speed. Every method (Bullet representations and statsim
+// variants and tables) is run from many independent initial states drawn from one
+// distribution, and its outcomes are compared with the reference (Bullet with the full mesh at a
+// small step) as distributions, each distance with a bootstrap interval, beside the distance
+// between two independent reference samples (the noise floor). The definitions are in
+// fidelity.cpp's file comment and in `statsim fidelity --help`.
+#pragma once
+
+#include "fidelity/metrics.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace statsim::tools::fidelity {
+
+struct FidelityOptions {
+  std::string shape = "bunny";  ///< bunny, box or lshape (compiled tables); ignored with `mesh`
+  std::string mesh;             ///< OBJ of a shape without a compiled table (needs a table)
+  /// Loaded tables: NAME, FILE.json (method "statistical:NAME").
+  std::vector<std::pair<std::string, std::string>> tables;
+  std::vector<std::string> methods;  ///< empty: the default list (see default_methods())
+  int runs = 500;                    ///< single drops per sample
+  double dt = 1.0 / 60.0;            ///< s, step of the methods
+  double reference_dt = 1e-3;        ///< s, step of the reference (Bullet full) in single drops
+  /// Settings of the single drops' reference: "gather" (tools/ref3d's, those the tables were
+  /// gathered with) or "bench" (statsim bench's Bullet settings). Piles always use "bench".
+  std::string reference = "gather";
+  double time_limit = 10.0;          ///< s, a run ends at rest or here
+  bool piles = true;
+  int pile_seeds = 20;               ///< piles: scene seeds 1..N (reference floor: N+1..2N)
+  int pile_count = 50;               ///< bodies per pile
+  double pile_reference_dt = 1.0 / 240.0;  ///< s
+  int bench_n = 100;                 ///< bodies of the step-time scene
+  int bench_steps = 300;             ///< steps of the step-time scene
+  bool timing = true;                ///< measure step_ms
+  std::uint64_t seed = 1;            ///< of the single-drop streams and the statsim worlds
+  unsigned threads = 0;              ///< 0: every core
+  int bootstrap = 200;               ///< resamples per interval
+  std::string meshes_dir;            ///< empty: the source tree's tools/meshes
+  bool allow_synthetic = false;      ///< box/lshape/bunny without a generated table: synthetic cube
+  bool progress = true;
+};
+
+/// Method names used when none are given: full, low, spheres7, sphere, statistical,
+/// statistical-norest, statistical-independent (those the shape supports).
+std::vector<std::string> default_methods();
+
+/// Outcome of one single drop.
+struct DropRun {
+  int config = -1;             ///< rest configuration: pose index, or the pose count for "other"
+  double rest_height = 0;      ///< centre of mass height at rest, m
+  double travel = 0;           ///< horizontal distance drop point to rest point, m
+  double bounces = 0;          ///< rises of the centre after the first contact (see the definitions)
+  double rest_time = 0;        ///< s, when the rest condition began
+  bool time_limited = false;   ///< reached the time limit before rest
+  bool impact = false;         ///< a first impact was seen
+  double impact_speed = 0;     ///< |v+| after the first impact, m/s
+  double impact_spin = 0;      ///< |w+| after the first impact, rad/s
+};
+
+/// Final state of one pile.
+struct PileRun {
+  std::vector<double> radius;  ///< horizontal distance of each body from the pile's centroid, m
+  std::vector<double> height;  ///< centre heights, m
+  std::vector<int> config;     ///< rest configurations (pose index, or the count for "other")
+  bool time_limited = false;
+  double seconds = 0;          ///< simulated time until all rested (or the limit)
+};
+
+/// A distance and its bootstrap interval.
+struct Distance {
+  double value = 0;
+  Interval ci;
+};
+
+/// Every distance of one sample against the reference.
+struct Distances {
+  Distance rest_tvd, rest_height_err, travel_w1, bounce_w1, rest_time_w1;
+  Distance first_impact_ks, first_impact_ks_v, first_impact_ks_w;
+  Distance summary_error;
+  bool piles = false;
+  Distance pile_radial_w1, pile_height_w1, pile_rest_tvd;
+};
+
+struct MethodResult {
+  std::string name;
+  std::string description;
+  double dt = 0;
+  std::vector<DropRun> drops;
+  std::vector<PileRun> piles;
+  Distances d;
+  double step_ms = -1;        ///< thread CPU ms per step on the benchmark scene; -1: not measured
+  long long table_bytes = -1; ///< -1: no table
+};
+
+struct FidelityResult {
+  FidelityOptions options;
+  std::string shape;                  ///< name of the body
+  double bounding_radius = 0;         ///< R, m
+  std::vector<std::string> pose_labels;  ///< rest configurations ("(x, y, z) h"), then "other"
+  MethodResult reference;             ///< sample A
+  MethodResult reference_b;           ///< sample B (noise floor)
+  Distances noise_floor;              ///< B against A
+  std::vector<MethodResult> methods;
+  std::vector<std::string> settings;  ///< engine settings, one per line
+  std::string command;
+  double seconds = 0;                 ///< wall time of the whole run
+};
+
+/// summary_error from the five single-drop distances (see summary_error_definition()).
+double summary_error(double rest_tvd, double rest_height_err, double travel_w1, double bounce_w1,
+                     double first_impact_ks);
+/// The sentence that defines summary_error (written into the JSON and the help).
+const char* summary_error_definition();
+/// The definitions of every measurement, for --help and the JSON.
+const char* fidelity_definitions();
+
+/// Distances of `method` against `reference` (both DropRun samples over the same rest
+/// configurations, `configs` of them including "other"); piles when both have piles.
+Distances compare(const std::vector<DropRun>& method, const std::vector<DropRun>& reference,
+                  const std::vector<PileRun>& method_piles, const std::vector<PileRun>& reference_piles, int configs,
+                  int resamples);
+
+/// Throws std::invalid_argument naming a bad option.
+void validate(const FidelityOptions& options);
+/// Runs everything. Throws std::runtime_error / std::invalid_argument.
+FidelityResult run_fidelity(const FidelityOptions& options);
+
+std::string fidelity_json(const FidelityResult& result);
+/// What the charts need back from fidelity_json()'s text (methods' distances, step_ms,
+/// table_bytes, the noise floor). Throws std::invalid_argument.
+FidelityResult fidelity_from_json(const std::string& text);
+std::string fidelity_table(const FidelityResult& result);
+void write_fidelity_chart(const FidelityResult& result, const std::filesystem::path& path);
+void write_metric_charts(const FidelityResult& result, const std::filesystem::path& dir);
+/// PNG: summary error (90% interval) against table bytes (log x), one point per method with a
+/// table (statistical tables), the noise floor and its interval marked. Throws
+/// std::invalid_argument when no method has a table.
+void write_bytes_chart(const FidelityResult& result, const std::filesystem::path& path);
+
+/// Adds `statsim fidelity`.
+void register_fidelity_commands(CLI::App& app);
+
+}  // namespace statsim::tools::fidelity

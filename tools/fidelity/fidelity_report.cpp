@@ -1,0 +1,613 @@
+// Output of `statsim fidelity`: the table on stdout, the JSON, the charts, and the command.
+#include "fidelity/fidelity.hpp"
+
+#include "common/atomic_file.hpp"
+#include "common/chart.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace statsim::tools::fidelity {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+std::string num(double x, const char* f = "%.3f")
+{
+  char b[64];
+  std::snprintf(b, sizeof b, f, x);
+  return b;
+}
+
+std::string with_ci(const Distance& d)
+{
+  return num(d.value) + " [" + num(d.ci.lo) + ", " + num(d.ci.hi) + "]";
+}
+
+void put(json& j, const char* key, const Distance& d)
+{
+  j[key] = d.value;
+  j[std::string(key) + "_ci"] = {d.ci.lo, d.ci.hi};
+}
+
+json distances_json(const Distances& d)
+{
+  json j;
+  put(j, "rest_tvd", d.rest_tvd);
+  put(j, "rest_height_err", d.rest_height_err);
+  put(j, "travel_w1", d.travel_w1);
+  put(j, "bounce_w1", d.bounce_w1);
+  put(j, "rest_time_w1", d.rest_time_w1);
+  put(j, "first_impact_ks", d.first_impact_ks);
+  put(j, "first_impact_ks_v", d.first_impact_ks_v);
+  put(j, "first_impact_ks_w", d.first_impact_ks_w);
+  put(j, "summary_error", d.summary_error);
+  if (d.piles) {
+    json p;
+    put(p, "radial_w1", d.pile_radial_w1);
+    put(p, "height_w1", d.pile_height_w1);
+    put(p, "rest_tvd", d.pile_rest_tvd);
+    j["pile"] = p;
+  }
+  return j;
+}
+
+json sample_json(const MethodResult& m, int configs)
+{
+  json j;
+  j["description"] = m.description;
+  j["dt"] = m.dt;
+  j["runs"] = m.drops.size();
+  std::size_t limited = 0, no_impact = 0;
+  std::vector<double> hist(static_cast<std::size_t>(configs), 0.0);
+  std::vector<double> travel, bounces, rest_time, height;
+  for (const DropRun& r : m.drops) {
+    limited += r.time_limited;
+    no_impact += !r.impact;
+    hist[static_cast<std::size_t>(r.config)] += 1.0 / static_cast<double>(m.drops.size());
+    travel.push_back(r.travel);
+    bounces.push_back(r.bounces);
+    rest_time.push_back(r.rest_time);
+    height.push_back(r.rest_height);
+  }
+  j["time_limited"] = limited;
+  j["no_impact"] = no_impact;
+  j["rest_histogram"] = hist;
+  j["mean_travel"] = mean(travel);
+  j["mean_bounces"] = mean(bounces);
+  j["mean_rest_time"] = mean(rest_time);
+  j["mean_rest_height_over_R"] = mean(height);
+  if (!m.piles.empty()) {
+    std::size_t pl = 0;
+    double secs = 0;
+    for (const PileRun& p : m.piles) pl += p.time_limited, secs += p.seconds;
+    j["pile_seeds"] = m.piles.size();
+    j["pile_time_limited"] = pl;
+    j["pile_mean_seconds"] = secs / static_cast<double>(m.piles.size());
+  }
+  return j;
+}
+
+// The command with every option that changes the results (not --threads, --json, --chart, ...).
+std::string command_line(const FidelityOptions& o)
+{
+  std::ostringstream c;
+  c.precision(17);
+  c << "statsim fidelity";
+  if (o.mesh.empty()) c << " --shape " << o.shape;
+  else c << " --mesh " << o.mesh;
+  for (const auto& t : o.tables) c << " --table " << t.first << "=" << t.second;
+  const std::vector<std::string> methods = o.methods.empty() ? default_methods() : o.methods;
+  c << " --methods ";
+  for (std::size_t i = 0; i < methods.size(); ++i) c << (i ? "," : "") << methods[i];
+  c << " --runs " << o.runs << " --reference " << o.reference << " --dt " << o.dt << " --reference-dt "
+    << o.reference_dt << " --time-limit "
+    << o.time_limit;
+  if (o.piles)
+    c << " --pile-seeds " << o.pile_seeds << " --pile-count " << o.pile_count << " --pile-reference-dt "
+      << o.pile_reference_dt;
+  else
+    c << " --no-piles";
+  if (o.timing) c << " --bench-n " << o.bench_n << " --bench-steps " << o.bench_steps;
+  else c << " --no-timing";
+  c << " --seed " << o.seed << " --bootstrap " << o.bootstrap;
+  if (o.allow_synthetic) c << " --allow-synthetic";
+  return c.str();
+}
+
+// A step given as seconds ("0.001") or as a rate ("1/240").
+double parse_step(const std::string& text, const char* option)
+{
+  const auto slash = text.find('/');
+  try {
+    std::size_t used = 0;
+    if (slash == std::string::npos) {
+      const double v = std::stod(text, &used);
+      if (used == text.size()) return v;
+    } else {
+      const double a = std::stod(text.substr(0, slash), &used);
+      if (used == slash) {
+        const std::string rest = text.substr(slash + 1);
+        const double b = std::stod(rest, &used);
+        if (used == rest.size() && b != 0) return a / b;
+      }
+    }
+  } catch (const std::exception&) {
+  }
+  throw std::invalid_argument(std::string(option) + ": expected seconds or 1/N, got '" + text + "'");
+}
+
+bool finite_positive(double x)
+{
+  return std::isfinite(x) && x > 0;
+}
+
+Distance get_distance(const json& j, const std::string& key)
+{
+  Distance d;
+  d.value = j.at(key).get<double>();
+  const json& ci = j.at(key + "_ci");
+  d.ci = {ci.at(0).get<double>(), ci.at(1).get<double>()};
+  return d;
+}
+
+Distances distances_from_json(const json& j)
+{
+  Distances d;
+  d.rest_tvd = get_distance(j, "rest_tvd");
+  d.rest_height_err = get_distance(j, "rest_height_err");
+  d.travel_w1 = get_distance(j, "travel_w1");
+  d.bounce_w1 = get_distance(j, "bounce_w1");
+  d.rest_time_w1 = get_distance(j, "rest_time_w1");
+  d.first_impact_ks = get_distance(j, "first_impact_ks");
+  d.first_impact_ks_v = get_distance(j, "first_impact_ks_v");
+  d.first_impact_ks_w = get_distance(j, "first_impact_ks_w");
+  d.summary_error = get_distance(j, "summary_error");
+  if (j.contains("pile")) {
+    d.piles = true;
+    const json& p = j.at("pile");
+    d.pile_radial_w1 = get_distance(p, "radial_w1");
+    d.pile_height_w1 = get_distance(p, "height_w1");
+    d.pile_rest_tvd = get_distance(p, "rest_tvd");
+  }
+  return d;
+}
+
+}  // namespace
+
+FidelityResult fidelity_from_json(const std::string& text)
+{
+  try {
+    const json j = json::parse(text);
+    FidelityResult r;
+    r.shape = j.at("shape").get<std::string>();
+    r.bounding_radius = j.at("bounding_radius").get<double>();
+    r.command = j.at("command").get<std::string>();
+    r.options.bench_n = j.at("options").at("bench_n").get<int>();
+    r.options.piles = j.at("options").at("piles").get<bool>();
+    // Runs before --reference existed used statsim bench's settings.
+    r.options.reference = j.at("options").value("reference", std::string("bench"));
+    r.noise_floor = distances_from_json(j.at("noise_floor"));
+    for (const auto& [name, m] : j.at("methods").items()) {
+      MethodResult x;
+      x.name = name;
+      x.d = distances_from_json(m);
+      x.step_ms = m.at("step_ms").is_null() ? -1.0 : m.at("step_ms").get<double>();
+      x.table_bytes = m.at("table_bytes").is_null() ? -1 : m.at("table_bytes").get<long long>();
+      r.methods.push_back(x);
+    }
+    return r;
+  } catch (const json::exception& e) {
+    throw std::invalid_argument(std::string("not a statsim fidelity JSON: ") + e.what());
+  }
+}
+
+std::string fidelity_json(const FidelityResult& r)
+{
+  const int configs = static_cast<int>(r.pose_labels.size());
+  json j;
+  j["generator"] = "statsim fidelity";
+  j["command"] = r.command;
+  j["shape"] = r.shape;
+  j["bounding_radius"] = r.bounding_radius;
+  j["summary_error_definition"] = summary_error_definition();
+  j["definitions"] = fidelity_definitions();
+  j["rest_configurations"] = r.pose_labels;
+  j["options"] = {{"runs", r.options.runs},
+                  {"dt", r.options.dt},
+                  {"reference", r.options.reference},
+                  {"reference_dt", r.options.reference_dt},
+                  {"time_limit", r.options.time_limit},
+                  {"piles", r.options.piles},
+                  {"pile_seeds", r.options.pile_seeds},
+                  {"pile_count", r.options.pile_count},
+                  {"pile_reference_dt", r.options.pile_reference_dt},
+                  {"bench_n", r.options.bench_n},
+                  {"bench_steps", r.options.bench_steps},
+                  {"seed", r.options.seed},
+                  {"bootstrap", r.options.bootstrap}};
+  json ref = sample_json(r.reference, configs);
+  ref["method"] = "full";
+  ref["reference"] = r.options.reference;
+  ref["description"] = r.reference.description;
+  ref["settings"] = r.settings;
+  j["reference"] = ref;
+  j["reference_b"] = sample_json(r.reference_b, configs);
+  json methods = json::object();
+  for (const MethodResult& m : r.methods) {
+    json x = distances_json(m.d);
+    if (m.step_ms >= 0) x["step_ms"] = m.step_ms;
+    else x["step_ms"] = nullptr;
+    if (m.table_bytes >= 0) x["table_bytes"] = m.table_bytes;
+    else x["table_bytes"] = nullptr;
+    x["sample"] = sample_json(m, configs);
+    methods[m.name] = x;
+  }
+  j["methods"] = methods;
+  j["noise_floor"] = distances_json(r.noise_floor);
+  j["seconds"] = r.seconds;
+  return j.dump(2) + "\n";
+}
+
+std::string fidelity_table(const FidelityResult& r)
+{
+  std::ostringstream s;
+  s << "# statsim fidelity: " << r.shape << " (R = " << num(r.bounding_radius, "%.4f") << " m), " << r.options.runs
+    << " single drops per sample";
+  if (r.options.piles) s << ", " << r.options.pile_seeds << " piles of " << r.options.pile_count;
+  s << "\n\nReference: Bullet full at dt " << num(r.options.reference_dt, "%.5g") << " s with the settings of statsim "
+    << r.options.reference;
+  if (r.options.piles)
+    s << " (piles: at " << num(r.options.pile_reference_dt, "%.5g") << " s with the settings of statsim bench)";
+  s << "; methods at dt " << num(r.options.dt, "%.5g") << " s. Distances with 90% bootstrap intervals.\n\n";
+  s << "| method | rest_tvd | rest_height_err | travel_w1 | bounce_w1 | rest_time_w1 | first_impact_ks (v, w) |";
+  if (r.options.piles) s << " pile radial_w1 | pile height_w1 | pile rest_tvd |";
+  s << " step_ms | table_bytes | summary_error |\n|---|---|---|---|---|---|---|";
+  if (r.options.piles) s << "---|---|---|";
+  s << "---|---|---|\n";
+  auto row = [&](const std::string& name, const Distances& d, double step_ms, long long bytes) {
+    s << "| " << name << " | " << with_ci(d.rest_tvd) << " | " << with_ci(d.rest_height_err) << " | "
+      << with_ci(d.travel_w1) << " | " << with_ci(d.bounce_w1) << " | " << with_ci(d.rest_time_w1) << " | "
+      << with_ci(d.first_impact_ks) << " (" << num(d.first_impact_ks_v.value) << ", "
+      << num(d.first_impact_ks_w.value) << ") |";
+    if (r.options.piles)
+      s << " " << with_ci(d.pile_radial_w1) << " | " << with_ci(d.pile_height_w1) << " | "
+        << with_ci(d.pile_rest_tvd) << " |";
+    s << " " << (step_ms >= 0 ? num(step_ms, "%.4g") : "-") << " | "
+      << (bytes >= 0 ? std::to_string(bytes) : "-") << " | " << with_ci(d.summary_error) << " |\n";
+  };
+  for (const MethodResult& m : r.methods) row(m.name, m.d, m.step_ms, m.table_bytes);
+  row("noise floor (reference B vs A)", r.noise_floor, -1, -1);
+  s << "\n";
+  auto counts = [&](const MethodResult& m) {
+    std::size_t limited = 0, no_impact = 0;
+    for (const DropRun& d : m.drops) limited += d.time_limited, no_impact += !d.impact;
+    std::size_t pl = 0;
+    for (const PileRun& p : m.piles) pl += p.time_limited;
+    s << "- " << m.name << " (" << m.description << "): " << limited << " of " << m.drops.size()
+      << " drops hit the time limit, " << no_impact << " without a first impact";
+    if (!m.piles.empty()) s << "; " << pl << " of " << m.piles.size() << " piles hit the time limit";
+    s << "\n";
+  };
+  counts(r.reference);
+  counts(r.reference_b);
+  for (const MethodResult& m : r.methods) counts(m);
+  s << "\nReference settings:\n";
+  for (const std::string& line : r.settings) s << "- " << line << "\n";
+  s << "\nRest configurations: ";
+  for (std::size_t i = 0; i < r.pose_labels.size(); ++i) s << (i ? "; " : "") << i << " " << r.pose_labels[i];
+  s << "\n\n" << summary_error_definition() << "\nWall time " << num(r.seconds, "%.1f") << " s.\n";
+  return s.str();
+}
+
+void write_fidelity_chart(const FidelityResult& r, const std::filesystem::path& path)
+{
+  chart::Chart c;
+  c.title = "statsim fidelity: " + r.shape + ", accuracy against time per step";
+  c.x = {"thread CPU time per step (ms), " + std::to_string(r.options.bench_n) + " bodies", chart::Scale::log10, std::nullopt, std::nullopt};
+  c.y = {"summary error (1 = at the goals)", chart::Scale::linear, std::nullopt, std::nullopt};
+  c.y.min = 0.0;
+  std::vector<std::pair<double, double>> pts;
+  for (std::size_t i = 0; i < r.methods.size(); ++i) {
+    const MethodResult& m = r.methods[i];
+    if (!finite_positive(m.step_ms)) continue;
+    chart::Series s;
+    s.name = m.name;
+    s.color = chart::palette(i);
+    s.x = {m.step_ms};
+    s.y = {m.d.summary_error.value};
+    s.line = false;
+    s.marker = chart::Marker::circle;
+    s.marker_size = 6;
+    s.labels = {m.name};
+    c.series.push_back(s);
+    chart::Series ci;
+    ci.x = {m.step_ms, m.step_ms};
+    ci.y = {m.d.summary_error.ci.lo, m.d.summary_error.ci.hi};
+    ci.color = chart::palette(i);
+    ci.line_width = 1.5;
+    c.series.push_back(ci);
+    pts.emplace_back(m.step_ms, m.d.summary_error.value);
+  }
+  // Pareto front: sorted by time, each point that is more accurate than every faster one.
+  std::sort(pts.begin(), pts.end());
+  chart::Series front;
+  front.name = "Pareto front";
+  front.color = chart::Color{60, 60, 60};
+  front.dashed = true;
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& p : pts)
+    if (p.second < best) {
+      best = p.second;
+      front.x.push_back(p.first);
+      front.y.push_back(p.second);
+    }
+  if (!front.x.empty()) c.series.push_back(front);
+  chart::ReferenceLine floor;
+  floor.value = r.noise_floor.summary_error.value;
+  floor.label = "noise floor";
+  c.reference_lines.push_back(floor);
+  chart::ReferenceLine goal;
+  goal.value = 1.0;
+  goal.label = "at the goals";
+  goal.color = chart::Color{200, 80, 80};
+  c.reference_lines.push_back(goal);
+  if (!pts.empty()) {
+    const double lo = pts.front().first, hi = pts.back().first;
+    chart::Band band;
+    band.name = "noise floor 90% interval";
+    band.x = {lo / 2, hi * 2};
+    band.lower = {r.noise_floor.summary_error.ci.lo, r.noise_floor.summary_error.ci.lo};
+    band.upper = {r.noise_floor.summary_error.ci.hi, r.noise_floor.summary_error.ci.hi};
+    band.color = chart::Color{110, 110, 110};
+    c.bands.push_back(band);
+    c.x.min = lo / 2;
+    c.x.max = hi * 2;
+  }
+  chart::write_png(c, path);
+}
+
+void write_bytes_chart(const FidelityResult& r, const std::filesystem::path& path)
+{
+  chart::Chart c;
+  c.title = "statsim fidelity: " + r.shape + ", summary error against table bytes";
+  c.x = {"signature table bytes", chart::Scale::log10, std::nullopt, std::nullopt};
+  c.y = {"summary error, 90% interval (1 = at the goals)", chart::Scale::linear, std::nullopt, std::nullopt};
+  c.y.min = 0.0;
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (std::size_t i = 0; i < r.methods.size(); ++i) {
+    const MethodResult& m = r.methods[i];
+    if (m.table_bytes <= 0) continue;
+    const double x = static_cast<double>(m.table_bytes);
+    // "statistical:NAME" is labelled NAME; the compiled table's methods keep their names.
+    const std::string label = m.name.rfind("statistical:", 0) == 0 ? m.name.substr(12) : m.name;
+    chart::Series s;
+    s.name = label;
+    s.color = chart::palette(i);
+    s.x = std::vector<double>{x};
+    s.y = std::vector<double>{m.d.summary_error.value};
+    s.line = false;
+    s.marker = chart::Marker::circle;
+    s.marker_size = 6;
+    s.labels = {label};
+    c.series.push_back(s);
+    chart::Series ci;
+    ci.x = std::vector<double>{x, x};
+    ci.y = std::vector<double>{m.d.summary_error.ci.lo, m.d.summary_error.ci.hi};
+    ci.color = chart::palette(i);
+    ci.line_width = 1.5;
+    c.series.push_back(ci);
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  if (c.series.empty()) throw std::invalid_argument("--chart-bytes: no method has a table (table_bytes)");
+  c.x.min = lo / 2;
+  c.x.max = hi * 2;
+  chart::ReferenceLine floor;
+  floor.value = r.noise_floor.summary_error.value;
+  floor.label = "noise floor";
+  c.reference_lines.push_back(floor);
+  chart::ReferenceLine goal;
+  goal.value = 1.0;
+  goal.label = "at the goals";
+  goal.color = chart::Color{200, 80, 80};
+  c.reference_lines.push_back(goal);
+  // Whole vectors moved in, not assigned from lists: GCC 12 warns (-Wnonnull) about its own
+  // copy into an empty vector there.
+  chart::Band band;
+  band.name = "noise floor 90% interval";
+  band.x = std::vector<double>{lo / 2, hi * 2};
+  band.lower = std::vector<double>{r.noise_floor.summary_error.ci.lo, r.noise_floor.summary_error.ci.lo};
+  band.upper = std::vector<double>{r.noise_floor.summary_error.ci.hi, r.noise_floor.summary_error.ci.hi};
+  band.color = chart::Color{110, 110, 110};
+  c.bands.push_back(band);
+  chart::write_png(c, path);
+}
+
+void write_metric_charts(const FidelityResult& r, const std::filesystem::path& dir)
+{
+  std::filesystem::create_directories(dir);
+  struct Metric {
+    const char* key;
+    const Distance Distances::*field;
+    bool pile;
+  };
+  const Metric metrics[] = {{"rest_tvd", &Distances::rest_tvd, false},
+                            {"rest_height_err", &Distances::rest_height_err, false},
+                            {"travel_w1", &Distances::travel_w1, false},
+                            {"bounce_w1", &Distances::bounce_w1, false},
+                            {"rest_time_w1", &Distances::rest_time_w1, false},
+                            {"first_impact_ks", &Distances::first_impact_ks, false},
+                            {"pile_radial_w1", &Distances::pile_radial_w1, true},
+                            {"pile_height_w1", &Distances::pile_height_w1, true},
+                            {"pile_rest_tvd", &Distances::pile_rest_tvd, true}};
+  for (const Metric& mt : metrics) {
+    if (mt.pile && !r.noise_floor.piles) continue;
+    chart::Chart c;
+    c.title = std::string("statsim fidelity: ") + r.shape + ", " + mt.key + " against time per step";
+    c.x = {"thread CPU time per step (ms)", chart::Scale::log10, std::nullopt, std::nullopt};
+    c.y = {std::string(mt.key) + " (90% interval)", chart::Scale::linear, std::nullopt, std::nullopt};
+    c.y.min = 0.0;
+    double lo = std::numeric_limits<double>::infinity(), hi = 0;
+    for (std::size_t i = 0; i < r.methods.size(); ++i) {
+      const MethodResult& m = r.methods[i];
+      if (!finite_positive(m.step_ms)) continue;
+      const Distance& d = m.d.*(mt.field);
+      chart::Series s;
+      s.name = m.name;
+      s.color = chart::palette(i);
+      s.x = {m.step_ms};
+      s.y = {d.value};
+      s.line = false;
+      s.marker = chart::Marker::circle;
+      s.marker_size = 6;
+      s.labels = {m.name};
+      c.series.push_back(s);
+      chart::Series ci;
+      ci.x = {m.step_ms, m.step_ms};
+      ci.y = {d.ci.lo, d.ci.hi};
+      ci.color = chart::palette(i);
+      c.series.push_back(ci);
+      lo = std::min(lo, m.step_ms);
+      hi = std::max(hi, m.step_ms);
+    }
+    if (c.series.empty()) continue;
+    c.x.min = lo / 2;
+    c.x.max = hi * 2;
+    chart::ReferenceLine floor;
+    floor.value = (r.noise_floor.*(mt.field)).value;
+    floor.label = "noise floor";
+    c.reference_lines.push_back(floor);
+    chart::write_png(c, dir / (std::string(mt.key) + ".png"));
+  }
+}
+
+void register_fidelity_commands(CLI::App& app)
+{
+  auto opts = std::make_shared<FidelityOptions>();
+  auto json_path = std::make_shared<std::string>();
+  auto chart_path = std::make_shared<std::string>();
+  auto charts_dir = std::make_shared<std::string>();
+  auto bytes_chart_path = std::make_shared<std::string>();
+  auto method_list = std::make_shared<std::string>();
+  auto table_args = std::make_shared<std::vector<std::string>>();
+  auto no_piles = std::make_shared<bool>(false);
+  auto no_timing = std::make_shared<bool>(false);
+  auto quiet = std::make_shared<bool>(false);
+  auto replot = std::make_shared<std::string>();
+  auto dt_text = std::make_shared<std::string>("1/60");
+  auto reference_dt_text = std::make_shared<std::string>("0.001");
+  auto pile_dt_text = std::make_shared<std::string>("1/240");
+  CLI::App* cmd = app.add_subcommand(
+      "fidelity",
+      std::string("Accuracy against speed: every method's single drops (and piles) against Bullet with the full "
+                  "mesh, as distances between distributions with bootstrap intervals and a noise floor.\n\n") +
+          fidelity_definitions() + "\n" + summary_error_definition());
+  cmd->add_option("--shape", opts->shape, "bunny, box or lshape (a compiled table)")
+      ->check(CLI::IsMember({"bunny", "box", "lshape"}));
+  cmd->add_option("--mesh", opts->mesh, "OBJ of a shape without a compiled table (Bullet full: GImpact of it; needs --table; statistical, "
+                  "-norest and -independent then use the first --table, whose rest poses classify every run)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--table", *table_args,
+                  "NAME=FILE.json (statsim gather --json): adds method statistical:NAME; repeatable");
+  cmd->add_option("--methods", *method_list,
+                  "comma-separated: full, low, hull, spheres7, sphere, statistical, statistical-norest, "
+                  "statistical-independent, statistical:NAME (default: full,low,spheres7,sphere,statistical,"
+                  "statistical-norest,statistical-independent)");
+  cmd->add_option("--runs", opts->runs, "single drops per sample")->capture_default_str();
+  cmd->add_option("--dt", *dt_text, "step of the methods, s (a number or 1/N)")->capture_default_str();
+  cmd->add_option("--reference-dt", *reference_dt_text, "step of the reference in single drops, s (a number or 1/N)")
+      ->capture_default_str();
+  cmd->add_option("--reference", opts->reference,
+                  "single drops' reference settings: gather (tools/ref3d's, the tables' own) or bench (statsim "
+                  "bench's); piles always use bench's")
+      ->check(CLI::IsMember({"gather", "bench"}))
+      ->capture_default_str();
+  cmd->add_option("--time-limit", opts->time_limit, "s; a run ends at rest or here")->capture_default_str();
+  cmd->add_flag("--no-piles", *no_piles, "skip the piles");
+  cmd->add_option("--pile-seeds", opts->pile_seeds, "piles: scene seeds 1..N (noise floor N+1..2N)")->capture_default_str();
+  cmd->add_option("--pile-count", opts->pile_count, "bodies per pile")->capture_default_str();
+  cmd->add_option("--pile-reference-dt", *pile_dt_text, "step of the reference in piles, s (a number or 1/N)")
+      ->capture_default_str();
+  cmd->add_option("--bench-n", opts->bench_n, "bodies of the step-time scene")->capture_default_str();
+  cmd->add_option("--bench-steps", opts->bench_steps, "steps of the step-time scene")->capture_default_str();
+  cmd->add_flag("--no-timing", *no_timing, "do not measure step_ms");
+  cmd->add_option("--seed", opts->seed, "seed of the single-drop streams")->capture_default_str();
+  cmd->add_option("--bootstrap", opts->bootstrap, "bootstrap resamples per interval")->capture_default_str();
+  cmd->add_option("--threads", opts->threads, "worker threads (0: every core); results do not depend on it")
+      ->capture_default_str();
+  cmd->add_option("--meshes", opts->meshes_dir, "directory of the meshes (default: the source tree's tools/meshes)");
+  cmd->add_flag("--allow-synthetic", opts->allow_synthetic, "use the synthetic cube table if the shape has none");
+  cmd->add_option("--json", *json_path, "write the results as JSON");
+  cmd->add_option("--chart", *chart_path, "PNG: summary error against time per step (log x), Pareto front, noise floor");
+  cmd->add_option("--metric-charts", *charts_dir, "directory: one PNG per distance");
+  cmd->add_option("--chart-bytes", *bytes_chart_path,
+                  "PNG: summary error against table bytes (log x), one point per statistical table, noise floor");
+  cmd->add_flag("--quiet", *quiet, "no progress on stderr");
+  cmd->add_option("--replot", *replot, "JSON of an earlier run: only redraw --chart / --chart-bytes / --metric-charts from it");
+  cmd->callback([=]() {
+    FidelityOptions o = *opts;
+    o.piles = !*no_piles;
+    o.timing = !*no_timing;
+    o.progress = !*quiet;
+    if (!method_list->empty()) {
+      std::stringstream ss(*method_list);
+      std::string m;
+      while (std::getline(ss, m, ','))
+        if (!m.empty()) o.methods.push_back(m);
+    }
+    for (const std::string& t : *table_args) {
+      const auto eq = t.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == t.size())
+        throw CLI::ValidationError("--table", "expected NAME=FILE.json, got '" + t + "'");
+      o.tables.emplace_back(t.substr(0, eq), t.substr(eq + 1));
+    }
+    try {
+      if (!replot->empty()) {
+        // Redraw the charts of an earlier run from its JSON, without running anything.
+        if (chart_path->empty() && charts_dir->empty() && bytes_chart_path->empty())
+          throw std::invalid_argument("--replot needs --chart, --chart-bytes or --metric-charts");
+        std::ifstream in(*replot, std::ios::binary);
+        if (!in) throw std::runtime_error(*replot + ": cannot open file");
+        std::ostringstream text;
+        text << in.rdbuf();
+        const FidelityResult r = fidelity_from_json(text.str());
+        if (!chart_path->empty()) write_fidelity_chart(r, *chart_path);
+        if (!charts_dir->empty()) write_metric_charts(r, *charts_dir);
+        if (!bytes_chart_path->empty()) write_bytes_chart(r, *bytes_chart_path);
+        return;
+      }
+      o.dt = parse_step(*dt_text, "--dt");
+      o.reference_dt = parse_step(*reference_dt_text, "--reference-dt");
+      o.pile_reference_dt = parse_step(*pile_dt_text, "--pile-reference-dt");
+      validate(o);
+      // Fail on unwritable outputs before the run, not after it.
+      if (!json_path->empty()) ensure_writable_directory(std::filesystem::absolute(*json_path).parent_path());
+      if (!chart_path->empty()) ensure_writable_directory(std::filesystem::absolute(*chart_path).parent_path());
+      if (!charts_dir->empty()) ensure_writable_directory(*charts_dir);
+      if (!bytes_chart_path->empty())
+        ensure_writable_directory(std::filesystem::absolute(*bytes_chart_path).parent_path());
+      FidelityResult r = run_fidelity(o);
+      r.command = command_line(o);
+      std::cout << fidelity_table(r) << std::flush;
+      if (!json_path->empty()) write_file_atomic(*json_path, fidelity_json(r));
+      if (!chart_path->empty()) write_fidelity_chart(r, *chart_path);
+      if (!charts_dir->empty()) write_metric_charts(r, *charts_dir);
+      if (!bytes_chart_path->empty()) write_bytes_chart(r, *bytes_chart_path);
+    } catch (const std::exception& e) {
+      std::cerr << "statsim fidelity: error: " << e.what() << "\n";
+      throw CLI::RuntimeError(1);
+    }
+  });
+}
+
+}  // namespace statsim::tools::fidelity
