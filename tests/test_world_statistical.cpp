@@ -8,6 +8,8 @@
 #include "tables/bunny.hpp"
 #include "tables/lshape.hpp"
 
+#include "../examples/demo.hpp"  // the demos' drop pattern, shared with drop_lshapes
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -356,7 +358,7 @@ statsim::World3<300> lshape_world;  // static storage: about 80 KB
 
 TEST_CASE("L-shapes that keep a rest pose on top of others fall asleep")
 {
-  // 300 L-shapes dropped from a column (examples/drop_lshapes): one picks a rest pose on the
+  // 300 L-shapes dropped as examples/drop_lshapes drops them: one picks a rest pose on the
   // ground, is then held up by others and can no longer turn into it; it must sleep where it is.
   using namespace statsim;
   WorldDef3 def;
@@ -365,23 +367,7 @@ TEST_CASE("L-shapes that keep a rest pose on top of others fall asleep")
   const ShapeId shape = lshape_world.add_shape(tables::lshape.view()).id;
   REQUIRE(lshape_world.add_plane(Vector3(0, 0, 1), 0).ok());
   Pcg32 rng(1, 0);
-  for (int i = 0; i < 300; ++i) {
-    BodyDef3 b;
-    b.shape = shape;
-    const float a = rng.uniform(0, 6.2831853f);
-    const float r = 0.4f * std::sqrt(rng.uniform());
-    const float z = 0.3f + 0.012f * float(i) + rng.uniform(0, 0.012f);
-    b.position = Vector3(r * std::cos(a), r * std::sin(a), z);
-    const float ax = rng.uniform(-1, 1), ay = rng.uniform(-1, 1), az = rng.uniform(-1, 1);
-    const float angle = rng.uniform(0, 3.14159265f);
-    const Vector3 axis = Vector3(ax, ay, az).norm() > 1e-3f ? Vector3(ax, ay, az).normalized() : Vector3(0, 0, 1);
-    b.orientation = Quaternion(Eigen::AngleAxisf(angle, axis));
-    const float vx = rng.uniform(-0.5f, 0.5f), vy = rng.uniform(-0.5f, 0.5f);
-    b.linear_velocity = Vector3(vx, vy, 0);
-    const float wx = rng.uniform(-5, 5), wy = rng.uniform(-5, 5), wz = rng.uniform(-5, 5);
-    b.angular_velocity = Vector3(wx, wy, wz);
-    REQUIRE(lshape_world.add_body(b).ok());
-  }
+  REQUIRE(demo::drop_cylinder(lshape_world, shape, 300, 0.4f, 0.3f, 0.012f, rng));
   int steps = 0;
   while (steps < 1200 && lshape_world.count(MotionState::asleep) < 300) {
     REQUIRE(lshape_world.step(1.0f / 60).status == Status::ok);
