@@ -309,6 +309,32 @@ std::string fidelity_table(const FidelityResult& r)
   return s.str();
 }
 
+
+// The summary error's reference lines (the noise floor and 1 = at the goals) and, once the x
+// range is set, the noise floor's 90% interval across the chart.
+void add_floor_and_goal(chart::Chart& c, const FidelityResult& r)
+{
+  chart::ReferenceLine floor;
+  floor.value = r.noise_floor.summary_error.value;
+  floor.label = "noise floor";
+  c.reference_lines.push_back(floor);
+  chart::ReferenceLine goal;
+  goal.value = 1.0;
+  goal.label = "at the goals";
+  goal.color = chart::Color{200, 80, 80};
+  c.reference_lines.push_back(goal);
+  if (!c.x.min || !c.x.max) return;
+  // Whole vectors moved in, not assigned from lists: GCC 12 warns (-Wnonnull) about its own
+  // copy into an empty vector there.
+  chart::Band b;
+  b.name = "noise floor 90% interval";
+  b.x = std::vector<double>{*c.x.min, *c.x.max};
+  b.lower = std::vector<double>{r.noise_floor.summary_error.ci.lo, r.noise_floor.summary_error.ci.lo};
+  b.upper = std::vector<double>{r.noise_floor.summary_error.ci.hi, r.noise_floor.summary_error.ci.hi};
+  b.color = chart::Color{110, 110, 110};
+  c.bands.push_back(b);
+}
+
 void write_fidelity_chart(const FidelityResult& r, const std::filesystem::path& path)
 {
   chart::Chart c;
@@ -352,27 +378,11 @@ void write_fidelity_chart(const FidelityResult& r, const std::filesystem::path& 
       front.y.push_back(p.second);
     }
   if (!front.x.empty()) c.series.push_back(front);
-  chart::ReferenceLine floor;
-  floor.value = r.noise_floor.summary_error.value;
-  floor.label = "noise floor";
-  c.reference_lines.push_back(floor);
-  chart::ReferenceLine goal;
-  goal.value = 1.0;
-  goal.label = "at the goals";
-  goal.color = chart::Color{200, 80, 80};
-  c.reference_lines.push_back(goal);
   if (!pts.empty()) {
-    const double lo = pts.front().first, hi = pts.back().first;
-    chart::Band band;
-    band.name = "noise floor 90% interval";
-    band.x = {lo / 2, hi * 2};
-    band.lower = {r.noise_floor.summary_error.ci.lo, r.noise_floor.summary_error.ci.lo};
-    band.upper = {r.noise_floor.summary_error.ci.hi, r.noise_floor.summary_error.ci.hi};
-    band.color = chart::Color{110, 110, 110};
-    c.bands.push_back(band);
-    c.x.min = lo / 2;
-    c.x.max = hi * 2;
+    c.x.min = pts.front().first / 2;
+    c.x.max = pts.back().first * 2;
   }
+  add_floor_and_goal(c, r);
   chart::write_png(c, path);
 }
 
@@ -412,24 +422,7 @@ void write_bytes_chart(const FidelityResult& r, const std::filesystem::path& pat
   if (c.series.empty()) throw std::invalid_argument("--chart-bytes: no method has a table (table_bytes)");
   c.x.min = lo / 2;
   c.x.max = hi * 2;
-  chart::ReferenceLine floor;
-  floor.value = r.noise_floor.summary_error.value;
-  floor.label = "noise floor";
-  c.reference_lines.push_back(floor);
-  chart::ReferenceLine goal;
-  goal.value = 1.0;
-  goal.label = "at the goals";
-  goal.color = chart::Color{200, 80, 80};
-  c.reference_lines.push_back(goal);
-  // Whole vectors moved in, not assigned from lists: GCC 12 warns (-Wnonnull) about its own
-  // copy into an empty vector there.
-  chart::Band band;
-  band.name = "noise floor 90% interval";
-  band.x = std::vector<double>{lo / 2, hi * 2};
-  band.lower = std::vector<double>{r.noise_floor.summary_error.ci.lo, r.noise_floor.summary_error.ci.lo};
-  band.upper = std::vector<double>{r.noise_floor.summary_error.ci.hi, r.noise_floor.summary_error.ci.hi};
-  band.color = chart::Color{110, 110, 110};
-  c.bands.push_back(band);
+  add_floor_and_goal(c, r);
   chart::write_png(c, path);
 }
 
