@@ -23,7 +23,10 @@
 #include "statsim/response.hpp"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 
 namespace statsim {
 
@@ -175,12 +178,121 @@ struct SignatureView {
   RestPosesView<D> rest;
 };
 
+/// 16-bit storage of N table values: value = offset + scale * Scalar(q[i]).
+template <std::uint32_t N>
+struct Quantized16 {
+  Scalar scale;
+  Scalar offset;
+  std::array<std::int16_t, N> q;
+};
+
+namespace detail {
+/// Nearest integer, ties to even (what std::nearbyint gives in the default rounding mode), for
+/// |x| < 2^62; constexpr where std::nearbyint is not.
+constexpr double round_half_even(double x)
+{
+  const double t = double(static_cast<long long>(x));  // truncated toward zero
+  const double r = x - t;
+  const bool odd = static_cast<long long>(t) % 2 != 0;
+  if (r > 0.5 || (r == 0.5 && odd)) return t + 1;
+  if (r < -0.5 || (r == -0.5 && odd)) return t - 1;
+  return t;
+}
+
+template <class T, class = void>
+struct is_quantized : std::false_type {};
+template <class T>
+struct is_quantized<T, std::void_t<decltype(std::declval<const T&>().q)>> : std::true_type {};
+
+/// The view of a table's values: a contiguous array of Scalar, or a `Quantized16`-like object.
+template <class Values>
+constexpr ValuesView values_view(const Values& v)
+{
+  if constexpr (is_quantized<Values>::value) {
+    return ValuesView{nullptr, v.q.data(), v.scale, v.offset};
+  } else {
+    return ValuesView{v.data(), nullptr, 1, 0};
+  }
+}
+
+template <class Values>
+constexpr AxisView axis_view(const Values& v)
+{
+  return AxisView{v.data(), static_cast<std::uint32_t>(v.size())};
+}
+
+constexpr const char* c_str(const char* s) { return s; }
+template <class S>
+constexpr auto c_str(const S& s) -> decltype(s.c_str())
+{
+  return s.c_str();
+}
+}  // namespace detail
+
+/// The 16-bit rule, the one every part of statsim uses (`statsim gather --precision i16`, the
+/// firmware, JSON tables): offset = mid-range, scale = range / 65534 (1 for a constant table),
+/// q = the nearest integer, ties to even, of (value - offset) / scale in double precision,
+/// clamped to +-32767. Works on `n` values at `values`; constexpr, so a table can be quantised at
+/// compile time and only its 16-bit form kept in flash.
+constexpr void quantize16(const Scalar* values, std::size_t n, Scalar& scale, Scalar& offset, std::int16_t* q)
+{
+  if (n == 0) {
+    scale = 1;
+    offset = 0;
+    return;
+  }
+  Scalar lo = values[0], hi = values[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = values[i] < lo ? values[i] : lo;
+    hi = values[i] > hi ? values[i] : hi;
+  }
+  offset = Scalar(0.5) * (lo + hi);
+  scale = hi > lo ? (hi - lo) / Scalar(65534) : Scalar(1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = detail::round_half_even((double(values[i]) - double(offset)) / double(scale));
+    q[i] = static_cast<std::int16_t>(r < -32767 ? -32767 : r > 32767 ? 32767 : r);
+  }
+}
+
+/// Builds the view of any signature storage that names its parts as `BasicSignature` does
+/// (fixed-size arrays in generated tables, growable ones in host tools): every part is read
+/// through `data()` and `size()`, and response values may be Scalars or `Quantized16`-like.
+/// The one place where a view is filled.
+template <int D, class S>
+constexpr SignatureView<D> signature_view(const S& s)
+{
+  SignatureView<D> v;
+  v.name = detail::c_str(s.name);
+  v.length = s.length;
+  v.bounding_radius = s.bounding_radius;
+  v.mass = s.mass;
+  v.unit_inertia = s.unit_inertia;
+  v.material = s.material;
+  v.restitution_threshold = s.restitution_threshold;
+  v.layout = s.layout;
+  v.height.spin_ratio = detail::axis_view(s.height_axis);
+  v.height.mean = detail::values_view(s.height_mean);
+  v.height.stddev = detail::values_view(s.height_stddev);
+  v.response.axes = {detail::axis_view(s.axis0), detail::axis_view(s.axis1), detail::axis_view(s.axis2),
+                     detail::axis_view(s.axis3)};
+  v.response.axis_count = s.axis_count;
+  v.response.components = D == 3 ? 6u : 3u;
+  v.response.mean = detail::values_view(s.response_mean);
+  v.response.stddev = detail::values_view(s.response_stddev);
+  v.rest.normals = s.rest_normals.data();
+  v.rest.heights = s.rest_heights.data();
+  v.rest.frequencies = s.rest_frequencies.data();
+  v.rest.count = static_cast<std::uint32_t>(s.rest_heights.size());
+  return v;
+}
+
 /// Storage of a generated signature; sizes are template arguments. Aggregate-initialised by the
-/// generated header, read by the runtime through `view()`.
+/// generated header, read by the runtime through `view()`. `Responses` holds one response table:
+/// `std::array<Scalar, N>` (`Signature`) or `Quantized16<N>` (`SignatureQ16`).
 ///   NH: height samples; A0..A3: response axis sizes (unused axes 1); NR: rest poses.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR>
-struct Signature {
+          std::uint32_t NR, class Responses>
+struct BasicSignature {
   static constexpr std::uint32_t components = D == 3 ? 6 : 3;
   static constexpr std::uint32_t cells = A0 * A1 * A2 * A3;
   static_assert(NH >= 1 && A0 >= 1 && A1 >= 1 && A2 >= 1 && A3 >= 1, "every axis needs a sample");
@@ -201,100 +313,44 @@ struct Signature {
   std::array<Scalar, A1> axis1;
   std::array<Scalar, A2> axis2;
   std::array<Scalar, A3> axis3;
-  std::array<Scalar, cells * components> response_mean;
-  std::array<Scalar, cells * components> response_stddev;
+  Responses response_mean;
+  Responses response_stddev;
   std::array<Scalar, NR * D> rest_normals;
   std::array<Scalar, NR> rest_heights;
   std::array<Scalar, NR> rest_frequencies;
 
-  constexpr SignatureView<D> view() const
-  {
-    SignatureView<D> v;
-    v.name = name;
-    v.length = length;
-    v.bounding_radius = bounding_radius;
-    v.mass = mass;
-    v.unit_inertia = unit_inertia;
-    v.material = material;
-    v.restitution_threshold = restitution_threshold;
-    v.layout = layout;
-    v.height.spin_ratio = AxisView{height_axis.data(), NH};
-    v.height.mean.f32 = height_mean.data();
-    v.height.stddev.f32 = height_stddev.data();
-    v.response.axes = {AxisView{axis0.data(), A0}, AxisView{axis1.data(), A1}, AxisView{axis2.data(), A2},
-                       AxisView{axis3.data(), A3}};
-    v.response.axis_count = axis_count;
-    v.response.components = components;
-    v.response.mean.f32 = response_mean.data();
-    v.response.stddev.f32 = response_stddev.data();
-    v.rest.normals = rest_normals.data();
-    v.rest.heights = rest_heights.data();
-    v.rest.frequencies = rest_frequencies.data();
-    v.rest.count = NR;
-    return v;
-  }
+  constexpr SignatureView<D> view() const { return signature_view<D>(*this); }
 };
 
-/// A signature whose response tables are 16-bit integers (value = offset + scale * q, one
-/// scale and offset per table), for firmware where flash is tight. Everything else as in
-/// `Signature`.
+/// A signature with float response tables: what `statsim gather` and `gather2d` write.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
           std::uint32_t NR>
-struct SignatureQ16 {
-  static constexpr std::uint32_t components = D == 3 ? 6 : 3;
-  static constexpr std::uint32_t cells = A0 * A1 * A2 * A3;
-  static_assert(NH >= 1 && A0 >= 1 && A1 >= 1 && A2 >= 1 && A3 >= 1, "every axis needs a sample");
+using Signature =
+    BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>>;
 
-  const char* name;
-  Scalar length;
-  Scalar bounding_radius;
-  Scalar mass;
-  std::array<Scalar, 3> unit_inertia;
-  Material material;
-  Scalar restitution_threshold;
-  ResponseLayout layout;
-  std::uint32_t axis_count;
-  std::array<Scalar, NH> height_axis;
-  std::array<Scalar, NH> height_mean;
-  std::array<Scalar, NH> height_stddev;
-  std::array<Scalar, A0> axis0;
-  std::array<Scalar, A1> axis1;
-  std::array<Scalar, A2> axis2;
-  std::array<Scalar, A3> axis3;
-  Scalar mean_scale, mean_offset;
-  std::array<std::int16_t, cells * components> response_mean;
-  Scalar stddev_scale, stddev_offset;
-  std::array<std::int16_t, cells * components> response_stddev;
-  std::array<Scalar, NR * D> rest_normals;
-  std::array<Scalar, NR> rest_heights;
-  std::array<Scalar, NR> rest_frequencies;
+/// A signature whose response tables are 16-bit integers (one scale and offset per table), for
+/// firmware where flash is tight; made from a `Signature` by `quantize16`.
+template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
+          std::uint32_t NR>
+using SignatureQ16 = BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>>;
 
-  constexpr SignatureView<D> view() const
-  {
-    SignatureView<D> v;
-    v.name = name;
-    v.length = length;
-    v.bounding_radius = bounding_radius;
-    v.mass = mass;
-    v.unit_inertia = unit_inertia;
-    v.material = material;
-    v.restitution_threshold = restitution_threshold;
-    v.layout = layout;
-    v.height.spin_ratio = AxisView{height_axis.data(), NH};
-    v.height.mean.f32 = height_mean.data();
-    v.height.stddev.f32 = height_stddev.data();
-    v.response.axes = {AxisView{axis0.data(), A0}, AxisView{axis1.data(), A1}, AxisView{axis2.data(), A2},
-                       AxisView{axis3.data(), A3}};
-    v.response.axis_count = axis_count;
-    v.response.components = components;
-    v.response.mean = ValuesView{nullptr, response_mean.data(), mean_scale, mean_offset};
-    v.response.stddev = ValuesView{nullptr, response_stddev.data(), stddev_scale, stddev_offset};
-    v.rest.normals = rest_normals.data();
-    v.rest.heights = rest_heights.data();
-    v.rest.frequencies = rest_frequencies.data();
-    v.rest.count = NR;
-    return v;
-  }
-};
+/// The 16-bit form of a float signature, by the rule of `quantize16`: everything but the response
+/// tables is copied. `inline constexpr auto t16 = statsim::quantize16(tables::box);` keeps only
+/// the 16-bit table in the program.
+template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
+          std::uint32_t NR>
+constexpr SignatureQ16<D, NH, A0, A1, A2, A3, NR> quantize16(const Signature<D, NH, A0, A1, A2, A3, NR>& s)
+{
+  SignatureQ16<D, NH, A0, A1, A2, A3, NR> q{s.name, s.length, s.bounding_radius, s.mass, s.unit_inertia,
+                                            s.material, s.restitution_threshold, s.layout, s.axis_count,
+                                            s.height_axis, s.height_mean, s.height_stddev, s.axis0, s.axis1,
+                                            s.axis2, s.axis3, {}, {}, s.rest_normals, s.rest_heights,
+                                            s.rest_frequencies};
+  quantize16(s.response_mean.data(), s.response_mean.size(), q.response_mean.scale, q.response_mean.offset,
+             q.response_mean.q.data());
+  quantize16(s.response_stddev.data(), s.response_stddev.size(), q.response_stddev.scale,
+             q.response_stddev.offset, q.response_stddev.q.data());
+  return q;
+}
 
 }  // namespace statsim

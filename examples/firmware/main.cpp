@@ -7,7 +7,7 @@
 //
 // Build-time choices (-D...): FIRMWARE_BODIES (bodies per world, 64), FIRMWARE_STEPS (2000),
 // FIRMWARE_SHAPE (0 box, 1 L-shape, 2 bunny), FIRMWARE_I16 (1: response tables as 16-bit
-// integers, quantised at compile time by the rule of `statsim gather --precision i16`).
+// integers, quantised at compile time by `statsim::quantize16`, the rule of `statsim gather --precision i16`).
 // FIRMWARE_TRACE (defined): also print the hash after every step. STATSIM_FIRMWARE is defined by
 // the Cortex-M build.
 
@@ -88,67 +88,10 @@ constexpr std::uint32_t grid_side(std::uint32_t n, std::uint32_t height, std::ui
 constexpr std::uint32_t columns3 = grid_side(bodies, 4, 4, 2);
 constexpr std::uint32_t columns2 = grid_side(bodies, 8, 8, 1);
 
-// ---- compile-time quantisation of a float table to 16 bits ---------------------------------------
-// The rule of tools/ref3d/gather.cpp (quantize): offset = mid-range, scale = range / 65534, q the
-// nearest integer (ties to even) of (value - offset) / scale in double precision.
-constexpr double round_half_even(double x)
-{
-  const double t = double(static_cast<long long>(x));  // truncated toward zero
-  const double r = x - t;
-  const bool odd = static_cast<long long>(t) % 2 != 0;
-  if (r > 0.5 || (r == 0.5 && odd)) return t + 1;
-  if (r < -0.5 || (r == -0.5 && odd)) return t - 1;
-  return t;
-}
-
-template <std::size_t N>
-constexpr void quantise(const std::array<float, N>& v, float& scale, float& offset, std::array<std::int16_t, N>& q)
-{
-  float lo = v[0], hi = v[0];
-  for (std::size_t i = 0; i < N; ++i) {
-    lo = v[i] < lo ? v[i] : lo;
-    hi = v[i] > hi ? v[i] : hi;
-  }
-  offset = 0.5f * (lo + hi);
-  scale = hi > lo ? (hi - lo) / 65534.0f : 1.0f;
-  for (std::size_t i = 0; i < N; ++i) {
-    const double r = round_half_even((double(v[i]) - double(offset)) / double(scale));
-    q[i] = static_cast<std::int16_t>(r < -32767 ? -32767 : r > 32767 ? 32767 : r);
-  }
-}
-
-template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR>
-constexpr statsim::SignatureQ16<D, NH, A0, A1, A2, A3, NR> to_q16(const statsim::Signature<D, NH, A0, A1, A2, A3, NR>& s)
-{
-  statsim::SignatureQ16<D, NH, A0, A1, A2, A3, NR> q{};
-  q.name = s.name;
-  q.length = s.length;
-  q.bounding_radius = s.bounding_radius;
-  q.mass = s.mass;
-  q.unit_inertia = s.unit_inertia;
-  q.material = s.material;
-  q.restitution_threshold = s.restitution_threshold;
-  q.layout = s.layout;
-  q.axis_count = s.axis_count;
-  q.height_axis = s.height_axis;
-  q.height_mean = s.height_mean;
-  q.height_stddev = s.height_stddev;
-  q.axis0 = s.axis0;
-  q.axis1 = s.axis1;
-  q.axis2 = s.axis2;
-  q.axis3 = s.axis3;
-  quantise(s.response_mean, q.mean_scale, q.mean_offset, q.response_mean);
-  quantise(s.response_stddev, q.stddev_scale, q.stddev_offset, q.response_stddev);
-  q.rest_normals = s.rest_normals;
-  q.rest_heights = s.rest_heights;
-  q.rest_frequencies = s.rest_frequencies;
-  return q;
-}
-
 #if FIRMWARE_I16
-constexpr auto table3 = to_q16(FIRMWARE_TABLE);
-constexpr auto table2 = to_q16(statsim::tables::square2d);
+// Quantised at compile time: only the 16-bit tables are in the image.
+constexpr auto table3 = statsim::quantize16(FIRMWARE_TABLE);
+constexpr auto table2 = statsim::quantize16(statsim::tables::square2d);
 constexpr const char* precision = "i16";
 #else
 constexpr const auto& table3 = FIRMWARE_TABLE;
