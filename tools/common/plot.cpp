@@ -138,9 +138,12 @@ void run_script(const std::string& script, const std::vector<std::string>& args)
   const Outcome o = run(argv);
   if (o.spawn_error != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + errno_text(o.spawn_error));
   if (o.status != 0) {
-    const std::string message = trimmed(o.err);
-    throw std::runtime_error(message.empty() ? path.string() + " failed with status " + std::to_string(o.status)
-                                             : message);
+    std::string message = trimmed(o.err);
+    if (message.empty()) message = path.string() + " failed with status " + std::to_string(o.status);
+    // "fig3.py: error: ..." reads "tool: error: fig3.py: ..." once the tool prefixes its own.
+    const std::string prefix = script + ": error: ";
+    if (message.rfind(prefix, 0) == 0) message.replace(0, prefix.size(), script + ": ");
+    throw std::runtime_error(message);
   }
   // Warnings of a run that succeeded (matplotlib building its font cache, ...).
   std::cerr << o.err << std::flush;

@@ -172,9 +172,9 @@ def main():
     args = parser.parse_args()
     if not (args.chart or args.chart_bytes or args.metric_charts):
         style.fail("nothing to draw: give --chart, --chart-bytes or --metric-charts")
-    for out in (args.chart, args.chart_bytes):
+    for option, out in (("--chart", args.chart), ("--chart-bytes", args.chart_bytes)):
         if out:
-            style.outputs(out)  # a bad name fails before anything is drawn
+            style.outputs(out, option)  # a bad name fails before anything is drawn
     data = Data(args.json)
     if args.chart:
         summary_chart(data, args.chart)

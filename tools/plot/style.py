@@ -204,11 +204,11 @@ def label_points(ax, points):
         taken.append(chosen.get_window_extent(renderer))
 
 
-def outputs(out):
+def outputs(out, option="--out"):
     """The PNG and SVG paths of `--out FILE.png` (or FILE.svg)."""
     stem, ext = os.path.splitext(out)
     if ext.lower() not in (".png", ".svg"):
-        fail(f"--out {out}: the name must end in .png or .svg (both are written)")
+        fail(f"{option} {out}: the name must end in .png or .svg (both are written)")
     return stem + ".png", stem + ".svg"
 
 
