@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -57,6 +58,14 @@ std::vector<std::string> csv_fields(const std::string& line)
     }
   }
   return out;
+}
+
+std::string read_file(const std::filesystem::path& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 std::vector<std::string> lines_of(const std::string& text)
@@ -243,29 +252,38 @@ TEST_CASE("bench 3D tiny configuration runs every method")
   check_csv(r);
   check_markdown(r);
 
-  // The CSV reads back (what --replot uses).
-  const BenchResult back = bench_from_csv(bench_csv(r));
-  REQUIRE(back.cells.size() == r.cells.size());
-  for (std::size_t i = 0; i < r.cells.size(); ++i) {
-    CHECK(back.cells[i].method == r.cells[i].method);
-    CHECK(back.cells[i].n == r.cells[i].n);
-    CHECK(back.cells[i].broadphase == r.cells[i].broadphase);
-    CHECK(back.cells[i].engine == r.cells[i].engine);
-    CHECK(back.cells[i].step_ms_median == doctest::Approx(r.cells[i].step_ms_median).epsilon(1e-8));
-    CHECK(back.cells[i].cpu_ms == doctest::Approx(r.cells[i].cpu_ms).epsilon(1e-8));
-  }
-
+  // The chart, drawn from bench_csv() by tools/plot/bench.py: one line per method and broad
+  // phase, read back from the CSV.
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "statsim_test_bench";
+  std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::filesystem::path png = dir / "bench.png";
   write_bench_chart(r, png);
+  CHECK(read_file(png).compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) == 0);
   CHECK(std::filesystem::file_size(png) > 1000);
-  // The CPU-time chart, from the read-back CSV (what --replot --chart-cpu draws).
-  BenchResult cpu = back;
+  const std::string svg = read_file(dir / "bench.svg");
+  CHECK(svg.find("ms per step (median of repeats)") != std::string::npos);
+  CHECK(svg.find("thread CPU") == std::string::npos);
+  for (const char* name : {"full (sap)", "full (dbvt)", "low (dbvt)", "sphere (sap)", "statistical (statsim)"}) {
+    CAPTURE(name);
+    CHECK(svg.find(name) != std::string::npos);
+  }
+  // The CPU-time chart (what --chart-cpu draws).
+  BenchResult cpu = r;
   cpu.options.chart_cpu = true;
-  const std::filesystem::path png_cpu = dir / "bench_cpu.png";
-  write_bench_chart(cpu, png_cpu);
-  CHECK(std::filesystem::file_size(png_cpu) > 1000);
+  write_bench_chart(cpu, dir / "bench_cpu.png");
+  CHECK(read_file(dir / "bench_cpu.svg").find("thread CPU ms per step") != std::string::npos);
+  // Nothing to draw when every cell was skipped: an error naming the problem.
+  BenchResult skipped = r;
+  for (BenchCell& c : skipped.cells) c.skipped = true;
+  std::string message;
+  try {
+    write_bench_chart(skipped, dir / "none.png");
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  CHECK(message.find("all skipped") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir / "none.png"));
   std::filesystem::remove_all(dir);
 }
 

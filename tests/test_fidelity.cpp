@@ -336,15 +336,30 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
     CHECK(full.at("sample").at(k) == j.at("reference").at(k));
   // The sphere rests on its collision radius, not on a face: its rest height differs.
   CHECK(j.at("methods").at("sphere").at("rest_height_err").get<double>() > 0.0);
+  CHECK(read(chart_path).compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) == 0);
   CHECK(fs::file_size(chart_path) > 1000);
+  const std::string svg = read(dir.file("fid.svg"));
+  CHECK(svg.find("summary error (1 = at the goals)") != std::string::npos);
+  CHECK(svg.find("noise floor 90% interval") != std::string::npos);
+  for (const char* m : {"sphere", "statistical", "full"}) CHECK(svg.find(m) != std::string::npos);
   CHECK(j.at("options").at("reference_dt").get<double>() == 1.0 / 120.0);
   CHECK(j.at("options").at("reference").get<std::string>() == "bench");
   CHECK(j.at("reference").at("reference").get<std::string>() == "bench");
-  // The bytes chart has one point (statistical); --replot redraws it from the JSON alone.
+  // The bytes chart has one point (statistical); --replot redraws it from the JSON alone, the
+  // same bytes.
   CHECK(fs::file_size(bytes_path) > 1000);
+  CHECK(read(dir.file("bytes.svg")).find("signature table bytes") != std::string::npos);
   const std::string replotted = dir.file("bytes_replot.png");
   CHECK(run_cli({"--replot", json_path, "--chart-bytes", replotted}) == 0);
-  CHECK(fs::file_size(replotted) > 1000);
+  CHECK(read(replotted) == read(bytes_path));
+  CHECK(read(dir.file("bytes_replot.svg")) == read(dir.file("bytes.svg")));
+  CHECK(run_cli({"--replot", json_path, "--metric-charts", dir.file("metrics")}) == 0);
+  CHECK(read(dir.file("metrics/rest_tvd.svg")).find("rest_tvd (90% interval)") != std::string::npos);
+  CHECK(fs::file_size(dir.file("metrics/first_impact_ks.png")) > 1000);
+  CHECK_FALSE(fs::exists(dir.file("metrics/pile_rest_tvd.png")));  // a run without piles
+  // A missing JSON fails, and draws nothing.
+  CHECK(run_cli({"--replot", dir.file("missing.json"), "--chart", dir.file("missing.png")}) != 0);
+  CHECK_FALSE(fs::exists(dir.file("missing.png")));
 }
 
 TEST_CASE("fidelity: the gathering's reference drops a box to rest on a face")

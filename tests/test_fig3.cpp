@@ -2,8 +2,8 @@
 // Checks properties of the experiment, not a hard-coded curve.
 #include <doctest/doctest.h>
 
-#include "common/chart.hpp"
 #include "common/parallel.hpp"
+#include "common/plot.hpp"
 #include "ref2d/fig3.hpp"
 
 #include <unistd.h>
@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -204,45 +205,86 @@ TEST_CASE("fig3: bad options are rejected")
   rejects(bad);
 }
 
-TEST_CASE("fig3: writes the CSV and the PNG")
+namespace {
+
+bool is_png(const std::string& bytes)
+{
+  return bytes.size() > 1000 && bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) == 0;
+}
+
+bool contains(const std::string& text, const std::string& part)
+{
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST_CASE("fig3: writes the CSV and draws the PNG and the SVG from it")
 {
   TempDir dir;
   Fig3Options o = small_config(2);
   o.trials_per_ratio = {20, 20, 20, 20};
   write_fig3_outputs(run_fig3(o), dir.path);
-  CHECK(dir.files() == std::vector<std::string>{"fig3.csv", "fig3.png"});
+  CHECK(dir.files() == std::vector<std::string>{"fig3.csv", "fig3.png", "fig3.svg"});
   const std::string csv = read_all(dir.path / "fig3.csv");
   CHECK(csv.rfind("ratio,min,mean,std,max,trials\n0,", 0) == 0);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 5);
-  CHECK(read_all(dir.path / "fig3.png").substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
+  CHECK(is_png(read_all(dir.path / "fig3.png")));
+  const std::string svg = read_all(dir.path / "fig3.svg");
+  CHECK(contains(svg, "<svg"));
+  CHECK(contains(svg, "height of centre at first contact (m)"));
+  CHECK(contains(svg, "min .. max of 20 drops"));  // the trial count comes from the CSV
 }
 
-TEST_CASE("toolkit: charts render and encode and fail cleanly")
+TEST_CASE("toolkit: a plotting script draws the same PNG and SVG from the same data, and fails clearly")
 {
   TempDir dir;
-  chart::Chart c;
-  c.title = "log-log";
-  c.x = {"N", chart::Scale::log10, {}, {}};
-  c.y = {"seconds", chart::Scale::log10, {}, {}};
-  chart::Series s;
-  s.name = "a";
-  s.x = {10, 100, 1000, 0.0};  // 0 cannot be shown on a log axis: skipped
-  s.y = {1e-5, 1e-4, 1e-3, 1.0};
-  s.marker = chart::Marker::circle;
-  s.labels = {"p", "q", "r", "s"};
-  c.series = {s};
-  const chart::Image img = chart::render(c);
-  CHECK(img.width == c.width);
-  CHECK(img.rgb.size() == static_cast<std::size_t>(c.width * c.height * 3));
-  chart::write_png(c, dir.path / "ok.png");
-  CHECK(read_all(dir.path / "ok.png").substr(1, 3) == "PNG");
+  const std::string csv = "ratio,min,mean,std,max,trials\n"
+                          "0,0.501,0.635,0.064,0.7071,400\n"
+                          "8,0.59,0.66,0.03,0.7071,400\n"
+                          "64,0.686,0.697,0.006,0.7071,400\n";
+  plot::run_script_on("fig3.py", csv, ".csv", {"--out", (dir.path / "a.png").string()});
+  plot::run_script_on("fig3.py", csv, ".csv", {"--out", (dir.path / "b.svg").string()});  // either name
+  CHECK(dir.files() == std::vector<std::string>{"a.png", "a.svg", "b.png", "b.svg"});
+  const std::string png = read_all(dir.path / "a.png");
+  const std::string svg = read_all(dir.path / "a.svg");
+  CHECK(is_png(png));
+  CHECK(contains(svg, "height of centre at first contact (m)"));
+  // No date, version or random id in either file: reruns are byte-identical.
+  CHECK(png == read_all(dir.path / "b.png"));
+  CHECK(svg == read_all(dir.path / "b.svg"));
+  CHECK(plot::svg_of(dir.path / "a.png") == dir.path / "a.svg");
 
-  c.series[0].y.pop_back();  // mismatched lengths
-  CHECK_THROWS_AS(chart::write_png(c, dir.path / "bad.png"), std::invalid_argument);
-  // Unwritable target: an error, and no temporary file left behind.
-  c.series[0].y.push_back(1.0);
-  CHECK_THROWS_AS(chart::write_png(c, dir.path / "missing-dir" / "x.png"), std::runtime_error);
-  CHECK(dir.files() == std::vector<std::string>{"ok.png"});
+  // A missing input, a file that is not the expected CSV, an unknown output kind: the script's
+  // message, naming the problem, and nothing written.
+  const auto error_of = [](const std::string& script, const std::vector<std::string>& args) {
+    try {
+      plot::run_script(script, args);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string out = (dir.path / "x.png").string();
+  std::string e = error_of("fig3.py", {(dir.path / "missing.csv").string(), "--out", out});
+  CHECK(contains(e, "missing.csv"));
+  CHECK(contains(e, "No such file"));
+  std::ofstream(dir.path / "other.csv") << "a,b\n1,2\n";
+  e = error_of("fig3.py", {(dir.path / "other.csv").string(), "--out", out});
+  CHECK(contains(e, "no column ratio"));
+  e = error_of("fig3.py", {(dir.path / "other.csv").string(), "--out", (dir.path / "x.pdf").string()});
+  CHECK(contains(e, ".png or .svg"));
+  CHECK(contains(error_of("no-such-script.py", {}), "not found"));
+  std::filesystem::remove(dir.path / "other.csv");
+  CHECK(dir.files() == std::vector<std::string>{"a.png", "a.svg", "b.png", "b.svg"});
+
+  // No interpreter with matplotlib: the message says how to get one.
+  ::setenv("STATSIM_PYTHON", "/nonexistent/python3", 1);
+  e = error_of("fig3.py", {(dir.path / "missing.csv").string(), "--out", out});
+  ::unsetenv("STATSIM_PYTHON");
+  CHECK(contains(e, "/nonexistent/python3"));
+  CHECK(contains(e, "tools/setup.sh"));
+  CHECK_NOTHROW(plot::find_python());
 }
 
 TEST_CASE("toolkit: parallel_for visits every index once whatever the thread count")

@@ -24,6 +24,8 @@ if [ "$minimal" = 0 ]; then
   packages+=(gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm)
   # Pictures: glTF export (tinygltf), GIF writing (giflib) and optimising (gifsicle).
   packages+=(libtinygltf-dev libgif-dev gifsicle)
+  # Charts: the plotting scripts of tools/plot (matplotlib for Debian's python3).
+  packages+=(python3-matplotlib)
   # Fuzzing (tests/fuzz, STATSIM_FUZZ=ON): clang with libFuzzer and the sanitizer runtimes.
   packages+=(clang-14 libclang-rt-14-dev)
 fi

@@ -2,7 +2,6 @@
 
 #include "bench/bench_internal.hpp"
 #include "common/atomic_file.hpp"
-#include "common/chart.hpp"
 #include "mesh/mass.hpp"
 #include "mesh/mesh.hpp"
 #include "mesh/shapes.hpp"

@@ -109,11 +109,10 @@ std::string bench_markdown(const BenchResult& result);
 /// response_ms,broad_ms,narrow_ms,fall_ms,settle_ms,fall_steps,first_sleep_step,step_ms_envelope,cpu_ms,repeats,steps,
 /// engine,skipped,asleep_end,mean_height_end,contacts_per_body_end,note. n/a values are empty.
 std::string bench_csv(const BenchResult& result);
-/// Log-log chart of time per step against N, one line per method and broad phase.
+/// Log-log chart of time per step against N, one line per method and broad phase: PATH (PNG)
+/// and PATH with .svg, drawn by tools/plot/bench.py from bench_csv(). Throws std::runtime_error
+/// when the chart cannot be drawn (see plot::run_script).
 void write_bench_chart(const BenchResult& result, const std::filesystem::path& path);
-/// The cells of a CSV written by bench_csv() (enough for write_bench_chart: method, n, broadphase,
-/// engine, skipped, step_ms_median; the shape is not in the CSV). Throws std::invalid_argument.
-BenchResult bench_from_csv(const std::string& csv);
 
 /// Adds `statsim bench`.
 void register_bench_commands(CLI::App& app);

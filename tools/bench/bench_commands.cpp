@@ -2,6 +2,7 @@
 #include "bench/bench.hpp"
 
 #include "common/atomic_file.hpp"
+#include "common/plot.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -10,11 +11,10 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace statsim::tools {
 namespace {
@@ -25,6 +25,7 @@ struct BenchCommand {
   std::string csv;
   std::string chart;
   std::string replot;
+  bool shape_given = false;
   bool quiet = false;
 };
 
@@ -56,16 +57,14 @@ void run_bench_command(BenchCommand& cmd)
     if (!cmd.replot.empty()) {
       // Redraw the chart of an earlier run from its CSV, without running anything.
       if (cmd.chart.empty()) throw std::invalid_argument("--replot needs --chart FILE.png");
-      std::ifstream in(cmd.replot, std::ios::binary);
-      if (!in) throw std::runtime_error(cmd.replot + ": cannot open file");
-      std::ostringstream text;
-      text << in.rdbuf();
-      BenchResult r = bench_from_csv(text.str());
-      r.options.shape = cmd.options.dim == 2 && cmd.options.shape == "bunny" ? "square" : cmd.options.shape;
-      r.options.chart_cpu = cmd.options.chart_cpu;
+      std::vector<std::string> args{cmd.replot, "--out", cmd.chart};
+      // The CSV does not hold the shape: the title names the one given, else the script's default
+      // (bunny; square for a 2D run, which it tells from the CSV).
+      if (cmd.shape_given) args.insert(args.end(), {"--shape", cmd.options.shape});
+      if (cmd.options.chart_cpu) args.push_back("--cpu");
       make_parent(cmd.chart);
-      write_bench_chart(r, cmd.chart);
-      std::printf("wrote %s\n", cmd.chart.c_str());
+      plot::run_script("bench.py", args);
+      std::printf("wrote %s and %s\n", cmd.chart.c_str(), plot::svg_of(cmd.chart).c_str());
       return;
     }
     cmd.options.dt = parse_dt(cmd.dt);
@@ -74,7 +73,10 @@ void run_bench_command(BenchCommand& cmd)
     validate_bench_options(cmd.options);
     // Fail on unwritable outputs before the run, not after it.
     if (!cmd.csv.empty()) make_parent(cmd.csv);
-    if (!cmd.chart.empty()) make_parent(cmd.chart);
+    if (!cmd.chart.empty()) {
+      make_parent(cmd.chart);
+      plot::find_python();  // a missing matplotlib too
+    }
     const BenchResult result = run_bench(cmd.options);
     std::fputs(bench_markdown(result).c_str(), stdout);
     if (!cmd.csv.empty()) {
@@ -83,7 +85,7 @@ void run_bench_command(BenchCommand& cmd)
     }
     if (!cmd.chart.empty()) {
       write_bench_chart(result, cmd.chart);
-      std::printf("wrote %s\n", cmd.chart.c_str());
+      std::printf("wrote %s and %s\n", cmd.chart.c_str(), plot::svg_of(cmd.chart).c_str());
     }
     std::fflush(stdout);
   } catch (const std::exception& e) {
@@ -103,7 +105,7 @@ void register_bench_commands(CLI::App& app)
       "representations (full, low, hull, spheres7, sphere) and statsim (statistical); --dim 2: Box2D vs statsim");
   BenchOptions& o = cmd->options;
   b->add_option("--dim", o.dim, "2 (Box2D vs statsim, squares) or 3 (Bullet vs statsim)")->capture_default_str();
-  b->add_option("--shape", o.shape, "3D: bunny, box or lshape; 2D: square")->capture_default_str();
+  CLI::Option* shape = b->add_option("--shape", o.shape, "3D: bunny, box or lshape; 2D: square")->capture_default_str();
   b->add_option("--n", o.counts, "Body counts, comma-separated")->delimiter(',')->capture_default_str();
   b->add_option("--methods", o.methods,
                 "Comma-separated; 3D: full, low, hull, spheres7, sphere, statistical (default: all but hull); "
@@ -125,12 +127,15 @@ void register_bench_commands(CLI::App& app)
   b->add_flag("--allow-synthetic", o.allow_synthetic,
               "Time the synthetic test signature when the shape's table is not generated yet (indicative only)");
   b->add_option("--csv", cmd->csv, "Write the CSV here");
-  b->add_option("--chart", cmd->chart, "Write the log-log PNG chart here");
-  b->add_option("--replot", cmd->replot, "Only redraw --chart from the CSV of an earlier run (pass its --shape)");
+  b->add_option("--chart", cmd->chart, "Write the log-log chart here as PNG, and as SVG beside it (FILE.svg)");
+  b->add_option("--replot", cmd->replot, "Only redraw --chart from the CSV of an earlier run (--shape names the shape in the title)");
   b->add_flag("--quiet", cmd->quiet, "No progress on stderr");
   b->add_flag("--chart-cpu", cmd->options.chart_cpu,
               "Chart the thread CPU time per step instead of the wall-clock median (a machine shared with other work)");
-  b->callback([cmd]() { run_bench_command(*cmd); });
+  b->callback([cmd, shape]() {
+    cmd->shape_given = shape->count() > 0;
+    run_bench_command(*cmd);
+  });
 }
 
 }  // namespace statsim::tools

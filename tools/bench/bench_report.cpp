@@ -1,15 +1,13 @@
 // Reports of `statsim bench`: Markdown (Table 1 layout), CSV and the log-log chart.
 #include "bench/bench.hpp"
 
-#include "common/chart.hpp"
+#include "common/plot.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <optional>
 #include <set>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -354,117 +352,11 @@ std::string bench_csv(const BenchResult& r)
   return s;
 }
 
-BenchResult bench_from_csv(const std::string& text)
-{
-  auto fields = [](const std::string& line) {
-    std::vector<std::string> out(1);
-    bool quoted = false;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-      const char c = line[i];
-      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        out.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = !quoted;
-      } else if (c == ',' && !quoted) {
-        out.emplace_back();
-      } else if (c != '\r') {
-        out.back() += c;
-      }
-    }
-    return out;
-  };
-  std::vector<std::string> lines;
-  {
-    std::string line;
-    for (char ch : text) {
-      if (ch == '\n') {
-        lines.push_back(line);
-        line.clear();
-      } else {
-        line += ch;
-      }
-    }
-    if (!line.empty()) lines.push_back(line);
-  }
-  if (lines.empty()) throw std::invalid_argument("bench CSV: empty");
-  const std::vector<std::string> header = fields(lines[0]);
-  auto column = [&](const char* name) {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return i;
-    throw std::invalid_argument(std::string("bench CSV: no column ") + name);
-  };
-  const std::size_t cm = column("method"), cn = column("n"), cb = column("broadphase"),
-                    cs = column("step_ms_median"), ce = column("engine"), ck = column("skipped");
-  // Optional: CSVs written before the column existed lack it.
-  std::size_t cc = header.size();
-  for (std::size_t i = 0; i < header.size(); ++i)
-    if (header[i] == "cpu_ms") cc = i;
-  BenchResult r;
-  for (std::size_t k = 1; k < lines.size(); ++k) {
-    if (lines[k].empty()) continue;
-    const std::vector<std::string> f = fields(lines[k]);
-    if (f.size() != header.size())
-      throw std::invalid_argument("bench CSV: line " + std::to_string(k + 1) + " has " + std::to_string(f.size()) +
-                                  " fields, the header " + std::to_string(header.size()));
-    BenchCell c;
-    c.method = f[cm];
-    c.n = std::stoi(f[cn]);
-    c.broadphase = f[cb];
-    c.engine = f[ce];
-    c.skipped = f[ck] == "1";
-    if (!c.skipped) c.step_ms_median = std::stod(f[cs]);
-    if (!c.skipped && cc < f.size() && !f[cc].empty()) c.cpu_ms = std::stod(f[cc]);
-    if (c.engine == "box2d") r.options.dim = 2;
-    r.cells.push_back(c);
-  }
-  return r;
-}
-
 void write_bench_chart(const BenchResult& r, const std::filesystem::path& path)
 {
-  chart::Chart c;
-  c.title = std::string("Time per step vs bodies: ") + r.options.shape + " drop (" +
-            (r.options.dim == 3 ? "Bullet vs statsim" : "Box2D vs statsim") + ")";
-  c.x = {"bodies N", chart::Scale::log10, std::nullopt, std::nullopt};
-  const bool cpu = r.options.chart_cpu;
-  const auto value = [cpu](const BenchCell& d) { return cpu ? d.cpu_ms : d.step_ms_median; };
-  c.y = {cpu ? "thread CPU ms per step (median of repeats)" : "ms per step (median of repeats)", chart::Scale::log10,
-         std::nullopt, std::nullopt};
-  c.width = 1000;
-  c.height = 680;
-  // A free decade above the data for the legend, top left (the slow methods start high at small
-  // N and climb to the right; the fast ones run along the bottom).
-  double top = 0;
-  for (const BenchCell& cell : r.cells)
-    if (!cell.skipped) top = std::max(top, value(cell));
-  if (top > 0) c.y.max = std::pow(10.0, std::ceil(std::log10(top)) + 1);
-  c.legend = chart::LegendPosition::top_left;
-  const chart::Marker markers[] = {chart::Marker::circle, chart::Marker::square, chart::Marker::diamond,
-                                   chart::Marker::triangle};
-  std::size_t index = 0;
-  std::map<std::string, std::size_t> colour_of;
-  for (const std::string& m : methods_of(r)) colour_of[m] = colour_of.size();
-  std::set<std::string> done;
-  for (const BenchCell& cell : r.cells) {
-    const std::string key = cell.method + "/" + cell.broadphase;
-    if (!done.insert(key).second) continue;
-    chart::Series s;
-    s.name = cell.engine == "bullet" ? cell.method + " (" + cell.broadphase + ")" : cell.method;
-    if (cell.engine == "statsim") s.name += " (statsim)";
-    for (const BenchCell& d : r.cells)
-      if (d.method == cell.method && d.broadphase == cell.broadphase && !d.skipped && value(d) > 0) {
-        s.x.push_back(d.n);
-        s.y.push_back(value(d));
-      }
-    if (s.x.empty()) continue;
-    s.color = chart::palette(colour_of[cell.method]);
-    s.dashed = cell.broadphase == "dbvt";
-    s.marker = markers[index++ % 4];
-    s.line_width = cell.engine == "statsim" ? 3.0 : 2.0;
-    c.series.push_back(s);
-  }
-  chart::write_png(c, path);
+  std::vector<std::string> args{"--out", path.string(), "--shape", r.options.shape};
+  if (r.options.chart_cpu) args.push_back("--cpu");
+  plot::run_script_on("bench.py", bench_csv(r), ".csv", args);
 }
 
 }  // namespace statsim::tools

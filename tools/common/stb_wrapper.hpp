@@ -1,7 +1,7 @@
-// The stb headers used by the charts (Debian libstb-dev), with their warnings silenced so that
-// -Wall -Wextra -Wconversion ... -Werror builds stay clean.
+// The stb headers used by `statsim render` for its pictures and captions (Debian libstb-dev),
+// with their warnings silenced so that -Wall -Wextra -Wconversion ... -Werror builds stay clean.
 //
-// Include this from exactly one .cpp file (chart.cpp): it compiles stb_image_write's
+// Include this from exactly one .cpp file (render/render.cpp): it compiles stb_image_write's
 // implementation into that file with internal linkage (STB_IMAGE_WRITE_STATIC), so it cannot
 // clash with another copy elsewhere in the program. stb_easy_font is all static functions.
 #pragma once

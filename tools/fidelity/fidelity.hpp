@@ -135,16 +135,24 @@ void validate(const FidelityOptions& options);
 FidelityResult run_fidelity(const FidelityOptions& options);
 
 std::string fidelity_json(const FidelityResult& result);
-/// What the charts need back from fidelity_json()'s text (methods' distances, step_ms,
-/// table_bytes, the noise floor). Throws std::invalid_argument.
-FidelityResult fidelity_from_json(const std::string& text);
 std::string fidelity_table(const FidelityResult& result);
-void write_fidelity_chart(const FidelityResult& result, const std::filesystem::path& path);
-void write_metric_charts(const FidelityResult& result, const std::filesystem::path& dir);
-/// PNG: summary error (90% interval) against table bytes (log x), one point per method with a
-/// table (statistical tables), the noise floor and its interval marked. Throws
-/// std::invalid_argument when no method has a table.
-void write_bytes_chart(const FidelityResult& result, const std::filesystem::path& path);
+
+/// The charts of a run; an empty path draws none. Each is a PNG at the path and an SVG beside it
+/// (FILE.svg), with the noise floor marked.
+struct Charts {
+  std::string chart;        ///< summary error (90% interval) against time per step (log x), the
+                            ///< Pareto front and the goal line
+  std::string bytes_chart;  ///< summary error (90% interval) against table bytes (log x), one point
+                            ///< per method with a table (statistical tables) and the goal line
+  std::string metric_dir;   ///< directory: one chart per distance against time per step
+  bool any() const { return !chart.empty() || !bytes_chart.empty() || !metric_dir.empty(); }
+};
+/// Draws `charts` with tools/plot/fidelity.py from the file written with fidelity_json(). Throws
+/// std::runtime_error with the script's message (a missing or malformed file, no method with a
+/// table for bytes_chart, no python3 with matplotlib: see plot::run_script).
+void write_charts(const std::filesystem::path& json_file, const Charts& charts);
+/// The same for a result in memory.
+void write_charts(const FidelityResult& result, const Charts& charts);
 
 /// Adds `statsim fidelity`.
 void register_fidelity_commands(CLI::App& app);

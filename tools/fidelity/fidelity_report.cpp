@@ -2,17 +2,14 @@
 #include "fidelity/fidelity.hpp"
 
 #include "common/atomic_file.hpp"
-#include "common/chart.hpp"
+#include "common/plot.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -146,70 +143,7 @@ double parse_step(const std::string& text, const char* option)
   throw std::invalid_argument(std::string(option) + ": expected seconds or 1/N, got '" + text + "'");
 }
 
-bool finite_positive(double x)
-{
-  return std::isfinite(x) && x > 0;
-}
-
-Distance get_distance(const json& j, const std::string& key)
-{
-  Distance d;
-  d.value = j.at(key).get<double>();
-  const json& ci = j.at(key + "_ci");
-  d.ci = {ci.at(0).get<double>(), ci.at(1).get<double>()};
-  return d;
-}
-
-Distances distances_from_json(const json& j)
-{
-  Distances d;
-  d.rest_tvd = get_distance(j, "rest_tvd");
-  d.rest_height_err = get_distance(j, "rest_height_err");
-  d.travel_w1 = get_distance(j, "travel_w1");
-  d.bounce_w1 = get_distance(j, "bounce_w1");
-  d.rest_time_w1 = get_distance(j, "rest_time_w1");
-  d.first_impact_ks = get_distance(j, "first_impact_ks");
-  d.first_impact_ks_v = get_distance(j, "first_impact_ks_v");
-  d.first_impact_ks_w = get_distance(j, "first_impact_ks_w");
-  d.summary_error = get_distance(j, "summary_error");
-  if (j.contains("pile")) {
-    d.piles = true;
-    const json& p = j.at("pile");
-    d.pile_radial_w1 = get_distance(p, "radial_w1");
-    d.pile_height_w1 = get_distance(p, "height_w1");
-    d.pile_rest_tvd = get_distance(p, "rest_tvd");
-  }
-  return d;
-}
-
 }  // namespace
-
-FidelityResult fidelity_from_json(const std::string& text)
-{
-  try {
-    const json j = json::parse(text);
-    FidelityResult r;
-    r.shape = j.at("shape").get<std::string>();
-    r.bounding_radius = j.at("bounding_radius").get<double>();
-    r.command = j.at("command").get<std::string>();
-    r.options.bench_n = j.at("options").at("bench_n").get<int>();
-    r.options.piles = j.at("options").at("piles").get<bool>();
-    // Runs before --reference existed used statsim bench's settings.
-    r.options.reference = j.at("options").value("reference", std::string("bench"));
-    r.noise_floor = distances_from_json(j.at("noise_floor"));
-    for (const auto& [name, m] : j.at("methods").items()) {
-      MethodResult x;
-      x.name = name;
-      x.d = distances_from_json(m);
-      x.step_ms = m.at("step_ms").is_null() ? -1.0 : m.at("step_ms").get<double>();
-      x.table_bytes = m.at("table_bytes").is_null() ? -1 : m.at("table_bytes").get<long long>();
-      r.methods.push_back(x);
-    }
-    return r;
-  } catch (const json::exception& e) {
-    throw std::invalid_argument(std::string("not a statsim fidelity JSON: ") + e.what());
-  }
-}
 
 std::string fidelity_json(const FidelityResult& r)
 {
@@ -310,178 +244,30 @@ std::string fidelity_table(const FidelityResult& r)
 }
 
 
-// The summary error's reference lines (the noise floor and 1 = at the goals) and, once the x
-// range is set, the noise floor's 90% interval across the chart.
-void add_floor_and_goal(chart::Chart& c, const FidelityResult& r)
+namespace {
+
+std::vector<std::string> chart_options(const Charts& charts)
 {
-  chart::ReferenceLine floor;
-  floor.value = r.noise_floor.summary_error.value;
-  floor.label = "noise floor";
-  c.reference_lines.push_back(floor);
-  chart::ReferenceLine goal;
-  goal.value = 1.0;
-  goal.label = "at the goals";
-  goal.color = chart::Color{200, 80, 80};
-  c.reference_lines.push_back(goal);
-  if (!c.x.min || !c.x.max) return;
-  // Whole vectors moved in, not assigned from lists: GCC 12 warns (-Wnonnull) about its own
-  // copy into an empty vector there.
-  chart::Band b;
-  b.name = "noise floor 90% interval";
-  b.x = std::vector<double>{*c.x.min, *c.x.max};
-  b.lower = std::vector<double>{r.noise_floor.summary_error.ci.lo, r.noise_floor.summary_error.ci.lo};
-  b.upper = std::vector<double>{r.noise_floor.summary_error.ci.hi, r.noise_floor.summary_error.ci.hi};
-  b.color = chart::Color{110, 110, 110};
-  c.bands.push_back(b);
+  std::vector<std::string> args;
+  if (!charts.chart.empty()) args.insert(args.end(), {"--chart", charts.chart});
+  if (!charts.bytes_chart.empty()) args.insert(args.end(), {"--chart-bytes", charts.bytes_chart});
+  if (!charts.metric_dir.empty()) args.insert(args.end(), {"--metric-charts", charts.metric_dir});
+  return args;
 }
 
-void write_fidelity_chart(const FidelityResult& r, const std::filesystem::path& path)
+}  // namespace
+
+void write_charts(const std::filesystem::path& json_file, const Charts& charts)
 {
-  chart::Chart c;
-  c.title = "statsim fidelity: " + r.shape + ", accuracy against time per step";
-  c.x = {"thread CPU time per step (ms), " + std::to_string(r.options.bench_n) + " bodies", chart::Scale::log10, std::nullopt, std::nullopt};
-  c.y = {"summary error (1 = at the goals)", chart::Scale::linear, std::nullopt, std::nullopt};
-  c.y.min = 0.0;
-  std::vector<std::pair<double, double>> pts;
-  for (std::size_t i = 0; i < r.methods.size(); ++i) {
-    const MethodResult& m = r.methods[i];
-    if (!finite_positive(m.step_ms)) continue;
-    chart::Series s;
-    s.name = m.name;
-    s.color = chart::palette(i);
-    s.x = {m.step_ms};
-    s.y = {m.d.summary_error.value};
-    s.line = false;
-    s.marker = chart::Marker::circle;
-    s.marker_size = 6;
-    s.labels = {m.name};
-    c.series.push_back(s);
-    chart::Series ci;
-    ci.x = {m.step_ms, m.step_ms};
-    ci.y = {m.d.summary_error.ci.lo, m.d.summary_error.ci.hi};
-    ci.color = chart::palette(i);
-    ci.line_width = 1.5;
-    c.series.push_back(ci);
-    pts.emplace_back(m.step_ms, m.d.summary_error.value);
-  }
-  // Pareto front: sorted by time, each point that is more accurate than every faster one.
-  std::sort(pts.begin(), pts.end());
-  chart::Series front;
-  front.name = "Pareto front";
-  front.color = chart::Color{60, 60, 60};
-  front.dashed = true;
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& p : pts)
-    if (p.second < best) {
-      best = p.second;
-      front.x.push_back(p.first);
-      front.y.push_back(p.second);
-    }
-  if (!front.x.empty()) c.series.push_back(front);
-  if (!pts.empty()) {
-    c.x.min = pts.front().first / 2;
-    c.x.max = pts.back().first * 2;
-  }
-  add_floor_and_goal(c, r);
-  chart::write_png(c, path);
+  std::vector<std::string> args{json_file.string()};
+  const std::vector<std::string> options = chart_options(charts);
+  args.insert(args.end(), options.begin(), options.end());
+  plot::run_script("fidelity.py", args);
 }
 
-void write_bytes_chart(const FidelityResult& r, const std::filesystem::path& path)
+void write_charts(const FidelityResult& r, const Charts& charts)
 {
-  chart::Chart c;
-  c.title = "statsim fidelity: " + r.shape + ", summary error against table bytes";
-  c.x = {"signature table bytes", chart::Scale::log10, std::nullopt, std::nullopt};
-  c.y = {"summary error, 90% interval (1 = at the goals)", chart::Scale::linear, std::nullopt, std::nullopt};
-  c.y.min = 0.0;
-  double lo = std::numeric_limits<double>::infinity(), hi = 0;
-  for (std::size_t i = 0; i < r.methods.size(); ++i) {
-    const MethodResult& m = r.methods[i];
-    if (m.table_bytes <= 0) continue;
-    const double x = static_cast<double>(m.table_bytes);
-    // "statistical:NAME" is labelled NAME; the compiled table's methods keep their names.
-    const std::string label = m.name.rfind("statistical:", 0) == 0 ? m.name.substr(12) : m.name;
-    chart::Series s;
-    s.name = label;
-    s.color = chart::palette(i);
-    s.x = std::vector<double>{x};
-    s.y = std::vector<double>{m.d.summary_error.value};
-    s.line = false;
-    s.marker = chart::Marker::circle;
-    s.marker_size = 6;
-    s.labels = {label};
-    c.series.push_back(s);
-    chart::Series ci;
-    ci.x = std::vector<double>{x, x};
-    ci.y = std::vector<double>{m.d.summary_error.ci.lo, m.d.summary_error.ci.hi};
-    ci.color = chart::palette(i);
-    ci.line_width = 1.5;
-    c.series.push_back(ci);
-    lo = std::min(lo, x);
-    hi = std::max(hi, x);
-  }
-  if (c.series.empty()) throw std::invalid_argument("--chart-bytes: no method has a table (table_bytes)");
-  c.x.min = lo / 2;
-  c.x.max = hi * 2;
-  add_floor_and_goal(c, r);
-  chart::write_png(c, path);
-}
-
-void write_metric_charts(const FidelityResult& r, const std::filesystem::path& dir)
-{
-  std::filesystem::create_directories(dir);
-  struct Metric {
-    const char* key;
-    const Distance Distances::*field;
-    bool pile;
-  };
-  const Metric metrics[] = {{"rest_tvd", &Distances::rest_tvd, false},
-                            {"rest_height_err", &Distances::rest_height_err, false},
-                            {"travel_w1", &Distances::travel_w1, false},
-                            {"bounce_w1", &Distances::bounce_w1, false},
-                            {"rest_time_w1", &Distances::rest_time_w1, false},
-                            {"first_impact_ks", &Distances::first_impact_ks, false},
-                            {"pile_radial_w1", &Distances::pile_radial_w1, true},
-                            {"pile_height_w1", &Distances::pile_height_w1, true},
-                            {"pile_rest_tvd", &Distances::pile_rest_tvd, true}};
-  for (const Metric& mt : metrics) {
-    if (mt.pile && !r.noise_floor.piles) continue;
-    chart::Chart c;
-    c.title = std::string("statsim fidelity: ") + r.shape + ", " + mt.key + " against time per step";
-    c.x = {"thread CPU time per step (ms)", chart::Scale::log10, std::nullopt, std::nullopt};
-    c.y = {std::string(mt.key) + " (90% interval)", chart::Scale::linear, std::nullopt, std::nullopt};
-    c.y.min = 0.0;
-    double lo = std::numeric_limits<double>::infinity(), hi = 0;
-    for (std::size_t i = 0; i < r.methods.size(); ++i) {
-      const MethodResult& m = r.methods[i];
-      if (!finite_positive(m.step_ms)) continue;
-      const Distance& d = m.d.*(mt.field);
-      chart::Series s;
-      s.name = m.name;
-      s.color = chart::palette(i);
-      s.x = {m.step_ms};
-      s.y = {d.value};
-      s.line = false;
-      s.marker = chart::Marker::circle;
-      s.marker_size = 6;
-      s.labels = {m.name};
-      c.series.push_back(s);
-      chart::Series ci;
-      ci.x = {m.step_ms, m.step_ms};
-      ci.y = {d.ci.lo, d.ci.hi};
-      ci.color = chart::palette(i);
-      c.series.push_back(ci);
-      lo = std::min(lo, m.step_ms);
-      hi = std::max(hi, m.step_ms);
-    }
-    if (c.series.empty()) continue;
-    c.x.min = lo / 2;
-    c.x.max = hi * 2;
-    chart::ReferenceLine floor;
-    floor.value = (r.noise_floor.*(mt.field)).value;
-    floor.label = "noise floor";
-    c.reference_lines.push_back(floor);
-    chart::write_png(c, dir / (std::string(mt.key) + ".png"));
-  }
+  plot::run_script_on("fidelity.py", fidelity_json(r), ".json", chart_options(charts));
 }
 
 void register_fidelity_commands(CLI::App& app)
@@ -541,10 +327,11 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--meshes", opts->meshes_dir, "directory of the meshes (default: the source tree's tools/meshes)");
   cmd->add_flag("--allow-synthetic", opts->allow_synthetic, "use the synthetic cube table if the shape has none");
   cmd->add_option("--json", *json_path, "write the results as JSON");
-  cmd->add_option("--chart", *chart_path, "PNG: summary error against time per step (log x), Pareto front, noise floor");
-  cmd->add_option("--metric-charts", *charts_dir, "directory: one PNG per distance");
+  cmd->add_option("--chart", *chart_path,
+                  "FILE.png (and FILE.svg): summary error against time per step (log x), Pareto front, noise floor");
+  cmd->add_option("--metric-charts", *charts_dir, "directory: one chart per distance (PNG and SVG)");
   cmd->add_option("--chart-bytes", *bytes_chart_path,
-                  "PNG: summary error against table bytes (log x), one point per statistical table, noise floor");
+                  "FILE.png (and FILE.svg): summary error against table bytes (log x), one point per statistical table, noise floor");
   cmd->add_flag("--quiet", *quiet, "no progress on stderr");
   cmd->add_option("--replot", *replot, "JSON of an earlier run: only redraw --chart / --chart-bytes / --metric-charts from it");
   cmd->callback([=]() {
@@ -565,18 +352,11 @@ void register_fidelity_commands(CLI::App& app)
       o.tables.emplace_back(t.substr(0, eq), t.substr(eq + 1));
     }
     try {
+      const Charts charts{*chart_path, *bytes_chart_path, *charts_dir};
       if (!replot->empty()) {
         // Redraw the charts of an earlier run from its JSON, without running anything.
-        if (chart_path->empty() && charts_dir->empty() && bytes_chart_path->empty())
-          throw std::invalid_argument("--replot needs --chart, --chart-bytes or --metric-charts");
-        std::ifstream in(*replot, std::ios::binary);
-        if (!in) throw std::runtime_error(*replot + ": cannot open file");
-        std::ostringstream text;
-        text << in.rdbuf();
-        const FidelityResult r = fidelity_from_json(text.str());
-        if (!chart_path->empty()) write_fidelity_chart(r, *chart_path);
-        if (!charts_dir->empty()) write_metric_charts(r, *charts_dir);
-        if (!bytes_chart_path->empty()) write_bytes_chart(r, *bytes_chart_path);
+        if (!charts.any()) throw std::invalid_argument("--replot needs --chart, --chart-bytes or --metric-charts");
+        write_charts(std::filesystem::path(*replot), charts);
         return;
       }
       o.dt = parse_step(*dt_text, "--dt");
@@ -589,13 +369,12 @@ void register_fidelity_commands(CLI::App& app)
       if (!charts_dir->empty()) ensure_writable_directory(*charts_dir);
       if (!bytes_chart_path->empty())
         ensure_writable_directory(std::filesystem::absolute(*bytes_chart_path).parent_path());
+      if (charts.any()) plot::find_python();  // a missing matplotlib too
       FidelityResult r = run_fidelity(o);
       r.command = command_line(o);
       std::cout << fidelity_table(r) << std::flush;
       if (!json_path->empty()) write_file_atomic(*json_path, fidelity_json(r));
-      if (!chart_path->empty()) write_fidelity_chart(r, *chart_path);
-      if (!charts_dir->empty()) write_metric_charts(r, *charts_dir);
-      if (!bytes_chart_path->empty()) write_bytes_chart(r, *bytes_chart_path);
+      if (charts.any()) write_charts(r, charts);
     } catch (const std::exception& e) {
       std::cerr << "statsim fidelity: error: " << e.what() << "\n";
       throw CLI::RuntimeError(1);

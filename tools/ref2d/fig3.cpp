@@ -38,8 +38,8 @@
 #include "ref2d/fig3.hpp"
 
 #include "common/atomic_file.hpp"
-#include "common/chart.hpp"
 #include "common/parallel.hpp"
+#include "common/plot.hpp"
 #include "common/progress.hpp"
 #include "ref2d/box2d_util.hpp"
 
@@ -275,79 +275,9 @@ std::string fig3_csv(const Fig3Result& result)
 
 void write_fig3_outputs(const Fig3Result& result, const std::filesystem::path& dir)
 {
-  write_file_atomic(dir / "fig3.csv", fig3_csv(result));
-
-  namespace ch = chart;
-  const ch::Color range_color{0, 114, 178};
-  const ch::Color mean_color{213, 94, 0};
-  ch::Chart c;
-  int min_trials = result.rows.front().trials;
-  int max_trials = min_trials;
-  for (const Fig3Row& r : result.rows) {
-    min_trials = std::min(min_trials, r.trials);
-    max_trials = std::max(max_trials, r.trials);
-  }
-  const std::string per_ratio =
-      min_trials == max_trials ? std::to_string(min_trials) : std::to_string(min_trials) + "-" + std::to_string(max_trials);
-  c.title = "Collision height of a 1x1 square falling on a line (Box2D)";
-  c.x.title = "|w| / |v|   (rad/m)";
-  c.y.title = "height of centre at first contact (m)";
-  c.y.min = 0.47;
-  c.y.max = 0.735;
-
-  ch::Band band;
-  band.name = "min .. max of " + per_ratio + " drops";
-  band.color = range_color;
-  band.opacity = 0.18;
-  ch::Series lo;
-  ch::Series hi;
-  ch::Series mean;
-  ch::Series sd_hi;
-  ch::Series sd_lo;
-  for (const Fig3Row& r : result.rows) {
-    band.x.push_back(r.ratio);
-    band.lower.push_back(r.min);
-    band.upper.push_back(r.max);
-    lo.x.push_back(r.ratio);
-    lo.y.push_back(r.min);
-    hi.x.push_back(r.ratio);
-    hi.y.push_back(r.max);
-    mean.x.push_back(r.ratio);
-    mean.y.push_back(r.mean);
-    sd_hi.x.push_back(r.ratio);
-    sd_hi.y.push_back(r.mean + r.std);
-    sd_lo.x.push_back(r.ratio);
-    sd_lo.y.push_back(r.mean - r.std);
-  }
-  for (ch::Series* s : {&lo, &hi}) {
-    s->color = range_color;
-    s->line_width = 1.5;
-    s->marker = ch::Marker::circle;
-    s->marker_size = 2.5;
-  }
-  sd_hi.name = "mean +/- std";
-  for (ch::Series* s : {&sd_hi, &sd_lo}) {
-    s->color = mean_color;
-    s->dashed = true;
-    s->line_width = 1.5;
-  }
-  mean.name = "mean";
-  mean.color = mean_color;
-  mean.line_width = 2.5;
-  mean.marker = ch::Marker::circle;
-  mean.marker_size = 4.0;
-  c.bands = {band};
-  c.series = {hi, lo, sd_hi, sd_lo, mean};
-
-  ch::ReferenceLine face;
-  face.value = 0.5;
-  face.label = "0.5: face hits first (inradius)";
-  ch::ReferenceLine corner;
-  corner.value = kHalfDiagonal;
-  corner.label = "sqrt(2)/2 = 0.7071: corner hits first";
-  c.reference_lines = {face, corner};
-  c.legend = ch::LegendPosition::automatic;
-  ch::write_png(c, dir / "fig3.png");
+  const std::filesystem::path csv = dir / "fig3.csv";
+  write_file_atomic(csv, fig3_csv(result));
+  plot::run_script("fig3.py", {csv.string(), "--out", (dir / "fig3.png").string()});
 }
 
 std::string fig3_summary(const Fig3Result& result)

@@ -128,7 +128,9 @@ Fig3Result run_fig3(const Fig3Options& options);
 /// The CSV text: header `ratio,min,mean,std,max,trials`, one row per ratio, plain decimals.
 std::string fig3_csv(const Fig3Result& result);
 
-/// Writes DIR/fig3.csv and DIR/fig3.png (atomically). Throws std::runtime_error on I/O errors.
+/// Writes DIR/fig3.csv (atomically), then draws DIR/fig3.png and DIR/fig3.svg from it with
+/// tools/plot/fig3.py. Throws std::runtime_error on I/O errors or when the chart cannot be drawn
+/// (see plot::run_script).
 void write_fig3_outputs(const Fig3Result& result, const std::filesystem::path& dir);
 
 /// A human-readable summary of the run: the table, how the skin bias was removed, diagnostics.

@@ -1,6 +1,7 @@
 #include "ref2d/ref2d.hpp"
 
 #include "common/atomic_file.hpp"
+#include "common/plot.hpp"
 #include "ref2d/fig3.hpp"
 #include "ref2d/gather2d.hpp"
 
@@ -28,10 +29,12 @@ void run_fig3_command(const Fig3Command& cmd)
     options.progress = true;
     validate_fig3_options(options);      // fail before creating anything
     ensure_writable_directory(cmd.out);  // and before the run, not after it
+    plot::find_python();                 // so is a missing matplotlib
     const Fig3Result result = run_fig3(options);
     write_fig3_outputs(result, cmd.out);
     std::fputs(fig3_summary(result).c_str(), stdout);
-    std::printf("wrote %s and %s\n", (cmd.out / "fig3.csv").c_str(), (cmd.out / "fig3.png").c_str());
+    std::printf("wrote %s, %s and %s\n", (cmd.out / "fig3.csv").c_str(), (cmd.out / "fig3.png").c_str(),
+                (cmd.out / "fig3.svg").c_str());
     std::fflush(stdout);
   } catch (const std::exception& e) {
     std::string message = e.what();
@@ -52,7 +55,7 @@ void register_ref2d_commands(CLI::App& app)
   CLI::App* fig3 = app.add_subcommand(
       "fig3",
       "Paper Figure 3: centre height of a 1x1 square at its first contact with a line vs |w|/|v|, "
-      "measured with Box2D (skin bias removed); writes DIR/fig3.csv and DIR/fig3.png");
+      "measured with Box2D (skin bias removed); writes DIR/fig3.csv, DIR/fig3.png and DIR/fig3.svg");
   fig3->add_option("--out", cmd->out, "Output directory (created if missing)")->required();
   fig3->add_option("--trials", cmd->options.trials, "Drops per |w|/|v| value")
       ->check(CLI::Range(2, std::numeric_limits<int>::max()))
