@@ -1,14 +1,13 @@
 #include <doctest/doctest.h>
 
-#include "synthetic_signature.hpp"
+#include "scenes/drop_pattern.hpp"
+#include "scenes/synthetic_signatures.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 #include "tables/box.hpp"
 #include "tables/bunny.hpp"
 #include "tables/lshape.hpp"
-
-#include "../examples/demo.hpp"  // the demos' drop pattern, shared with drop_lshapes
 
 #include <algorithm>
 #include <cmath>
@@ -360,14 +359,9 @@ TEST_CASE("L-shapes that keep a rest pose on top of others fall asleep")
 {
   // 300 L-shapes dropped as examples/drop_lshapes drops them: one picks a rest pose on the
   // ground, is then held up by others and can no longer turn into it; it must sleep where it is.
-  using namespace statsim;
   WorldDef3 def;
   def.seed = 1;
-  lshape_world.configure(def);
-  const ShapeId shape = lshape_world.add_shape(tables::lshape.view()).id;
-  REQUIRE(lshape_world.add_plane(Vector3(0, 0, 1), 0).ok());
-  Pcg32 rng(1, 0);
-  REQUIRE(demo::drop_cylinder(lshape_world, shape, 300, 0.4f, 0.3f, 0.012f, rng));
+  REQUIRE(tools::scenes::drop_on_ground(lshape_world, def, tables::lshape.view(), {300, 0.4f, 0.3f, 0.012f}).ok());
   int steps = 0;
   while (steps < 1200 && lshape_world.count(MotionState::asleep) < 300) {
     REQUIRE(lshape_world.step(1.0f / 60).status == Status::ok);
