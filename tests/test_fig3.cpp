@@ -5,8 +5,7 @@
 #include "common/chart.hpp"
 #include "common/parallel.hpp"
 #include "ref2d/fig3.hpp"
-
-#include <unistd.h>
+#include "support/temp_dir.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -19,6 +18,9 @@
 #include <vector>
 
 using namespace statsim::tools;
+
+using statsim::testing::read_file;
+using statsim::testing::TempDir;
 
 namespace {
 
@@ -54,32 +56,6 @@ double brute_force_height(const Fig3Drop& d, double speed)
     }
   }
   return -1.0;
-}
-
-struct TempDir {
-  std::filesystem::path path;
-  TempDir()
-      : path(std::filesystem::temp_directory_path() / ("statsim-test-fig3-" + std::to_string(::getpid())))
-  {
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  std::vector<std::string> files() const
-  {
-    std::vector<std::string> names;
-    for (const auto& e : std::filesystem::directory_iterator(path)) {
-      names.push_back(e.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-};
-
-std::string read_all(const std::filesystem::path& p)
-{
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
@@ -206,20 +182,20 @@ TEST_CASE("fig3: bad options are rejected")
 
 TEST_CASE("fig3: writes the CSV and the PNG")
 {
-  TempDir dir;
+  TempDir dir("fig3");
   Fig3Options o = small_config(2);
   o.trials_per_ratio = {20, 20, 20, 20};
   write_fig3_outputs(run_fig3(o), dir.path);
-  CHECK(dir.files() == std::vector<std::string>{"fig3.csv", "fig3.png"});
-  const std::string csv = read_all(dir.path / "fig3.csv");
+  CHECK(dir.entries() == std::vector<std::string>{"fig3.csv", "fig3.png"});
+  const std::string csv = read_file(dir.path / "fig3.csv");
   CHECK(csv.rfind("ratio,min,mean,std,max,trials\n0,", 0) == 0);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 5);
-  CHECK(read_all(dir.path / "fig3.png").substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
+  CHECK(read_file(dir.path / "fig3.png").substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
 }
 
 TEST_CASE("toolkit: charts render and encode and fail cleanly")
 {
-  TempDir dir;
+  TempDir dir("fig3");
   chart::Chart c;
   c.title = "log-log";
   c.x = {"N", chart::Scale::log10, {}, {}};
@@ -235,14 +211,14 @@ TEST_CASE("toolkit: charts render and encode and fail cleanly")
   CHECK(img.width == c.width);
   CHECK(img.rgb.size() == static_cast<std::size_t>(c.width * c.height * 3));
   chart::write_png(c, dir.path / "ok.png");
-  CHECK(read_all(dir.path / "ok.png").substr(1, 3) == "PNG");
+  CHECK(read_file(dir.path / "ok.png").substr(1, 3) == "PNG");
 
   c.series[0].y.pop_back();  // mismatched lengths
   CHECK_THROWS_AS(chart::write_png(c, dir.path / "bad.png"), std::invalid_argument);
   // Unwritable target: an error, and no temporary file left behind.
   c.series[0].y.push_back(1.0);
   CHECK_THROWS_AS(chart::write_png(c, dir.path / "missing-dir" / "x.png"), std::runtime_error);
-  CHECK(dir.files() == std::vector<std::string>{"ok.png"});
+  CHECK(dir.entries() == std::vector<std::string>{"ok.png"});
 }
 
 TEST_CASE("toolkit: parallel_for visits every index once whatever the thread count")
