@@ -19,8 +19,7 @@
 
 using namespace statsim::tools;
 
-using statsim::testing::read_file;
-using statsim::testing::TempDir;
+using namespace statsim::testing;
 
 namespace {
 

@@ -25,8 +25,7 @@
 
 using namespace statsim::tools;
 
-using statsim::testing::read_file;
-using statsim::testing::TempDir;
+using namespace statsim::testing;
 
 namespace {
 
@@ -295,14 +294,23 @@ TEST_CASE("gather2d: the committed L table is sane")
   check_committed_table(statsim::tables::lshape2d, l.inradius_min, l.bounding_radius, 3);
 }
 
+namespace {
+// compare2d's options for `drops` drops, each run once (the square table is committed).
+Compare2dOptions compare_options(int drops)
+{
+  REQUIRE(compare2d_has_table("square"));
+  Compare2dOptions o;
+  o.drops = drops;
+  o.repeat = 1;
+  return o;
+}
+}  // namespace
+
 TEST_CASE("compare2d: a small drop runs in both simulations and gives finite distances")
 {
-  REQUIRE(compare2d_has_table("square"));  // tables/square2d.hpp is committed
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(2);
   o.n = 12;
   o.steps = 150;
-  o.drops = 2;
-  o.repeat = 1;
   const Compare2dResult r = run_compare2d(o);
   // Two drops pooled: every body of both is in the final states.
   REQUIRE(r.box2d.final.size() == 24);
@@ -337,12 +345,9 @@ TEST_CASE("compare2d: a small drop runs in both simulations and gives finite dis
 
 TEST_CASE("compare2d: pooled drops are the drops run one by one")
 {
-  REQUIRE(compare2d_has_table("square"));  // tables/square2d.hpp is committed
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(2);
   o.n = 8;
   o.steps = 120;
-  o.repeat = 1;
-  o.drops = 2;
   const Compare2dResult both = run_compare2d(o);
   o.drops = 1;
   const Compare2dResult first = run_compare2d(o);
@@ -371,13 +376,10 @@ TEST_CASE("compare2d: pooled drops are the drops run one by one")
 
 TEST_CASE("compare2d: squares wedged between sleeping ones fall asleep")
 {
-  REQUIRE(compare2d_has_table("square"));  // tables/square2d.hpp is committed
   // Seed 2 wedges squares between two sleepers, where the contact passes leave a velocity that
   // the overlap correction undoes every step: judged by |v| alone, 2 of the 100 never slept.
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(1);
   o.seed = 2;
-  o.drops = 1;
-  o.repeat = 1;
   const Compare2dResult r = run_compare2d(o);
   CHECK(r.statsim.asleep == o.n);
 }

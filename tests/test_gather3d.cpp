@@ -29,10 +29,7 @@ namespace fs = std::filesystem;
 using namespace statsim::tools;
 using namespace statsim::tools::ref3d;
 
-using statsim::testing::header_numbers;
-using statsim::testing::HeaderNumbers;
-using statsim::testing::read_file;
-using statsim::testing::TempDir;
+using namespace statsim::testing;
 
 namespace {
 

@@ -26,8 +26,7 @@
 namespace fs = std::filesystem;
 using namespace statsim::tools;
 
-using statsim::testing::read_file;
-using statsim::testing::TempDir;
+using namespace statsim::testing;
 
 namespace {
 
