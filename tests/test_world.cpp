@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include "scenes/synthetic_signatures.hpp"
+#include "support/world_states.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
@@ -253,24 +254,19 @@ TEST_CASE("two worlds with the same seed stay bit-identical - another seed diffe
     return w;
   };
   auto a = make(1), b = make(1), c = make(99);
-  auto same_positions = [](const WorldCore3& x, const WorldCore3& y) {
-    for (std::uint32_t i = 0; i < x.body_count(); ++i)
-      if (x.body(i).position != y.body(i).position) return false;
-    return true;
-  };
-  REQUIRE(same_positions(*a, *c));
+  REQUIRE(testing::same_body_states(*a, *c));
   int first_difference = -1;
   for (int i = 0; i < 400; ++i) {
     REQUIRE(a->step(1.0f / 60).ok());
     REQUIRE(b->step(1.0f / 60).ok());
     REQUIRE(c->step(1.0f / 60).ok());
-    REQUIRE(same_positions(*a, *b));
+    REQUIRE(testing::same_body_states(*a, *b));
     REQUIRE(a->state_hash() == b->state_hash());
-    if (first_difference < 0 && !same_positions(*a, *c)) first_difference = i;
+    if (first_difference < 0 && !testing::same_body_states(*a, *c)) first_difference = i;
   }
-  MESSAGE("seeds 1 and 99: first different positions after step " << first_difference);
+  MESSAGE("seeds 1 and 99: first different body states after step " << first_difference);
   CHECK(first_difference >= 0);  // the per-body random streams differ, and so do the trajectories
-  CHECK_FALSE(same_positions(*a, *c));
+  CHECK_FALSE(testing::same_body_states(*a, *c));
   CHECK(a->count(MotionState::asleep) > 0);
 }
 
