@@ -7,6 +7,7 @@
 #include "tables/bunny.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace {
@@ -55,13 +56,12 @@ int main(int argc, char** argv)
   }
   statsim::WorldDef3 def;
   def.seed = o.seed;
-  world.configure(def);
-  const statsim::ShapeId shape = world.add_shape(statsim::tables::bunny.view()).id;
-  world.add_plane(statsim::Vector3(0, 0, 1), 0);
-  statsim::Pcg32 rng(o.seed, 0);
   // A cylinder wide enough for a low pile: radius grows with sqrt(N).
   const float radius = 0.1f * std::sqrt(float(o.n));
-  if (!demo::drop_cylinder(world, shape, o.n, radius, 0.3f, 2.0f / float(o.n) + 0.0004f, rng)) return 1;
+  statsim::ShapeId shape = 0;
+  if (!demo::drop("bunnies", world, def, statsim::tables::bunny.view(), {o.n, radius, 0.3f, 2.0f / float(o.n) + 0.0004f},
+                  0, shape))
+    return 1;
   int steps = 0;
   const double ms = demo::run(world, o, steps);
   if (ms < 0) return 1;

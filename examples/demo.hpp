@@ -1,19 +1,14 @@
-// Shared by the 3D demos: dropping bodies from a cylinder pattern, timing the steps, printing the
-// summary, and writing per-frame transforms. Not a demo itself.
-//
-// Frame files are CSV with the header line
-//   frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius
-// one row per body per written frame: the step, the time after it (s), the body's index, its
-// shape's name (the signature's: box, lshape, bunny; sphere for a plain sphere), position in metres (centre of mass, z up),
-// orientation as a unit quaternion (body to world), state 0 moving, 1 settling, 2 asleep, and the
-// current collision-sphere radius (m). `statsim render` and `statsim export` read these files
-// (README "Pictures" documents the format).
+// Shared by the 3D demos: parsing their options, timing the steps, printing the summary, and
+// the main of the plain drop demos. Not a demo itself. The drop pattern and the frame-file
+// writer are the project's shared ones (tools/scenes: drop_pattern.hpp, frames.hpp, which
+// documents the format that `statsim render` and `statsim export` read).
 #pragma once
 
+#include "scenes/drop_pattern.hpp"
+#include "scenes/frames.hpp"
 #include "statsim/world3.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -53,35 +48,6 @@ inline bool parse(int argc, char** argv, Options& o, const char* usage)
   return true;
 }
 
-/// Drops `n` bodies of `shape` from a cylinder of radius `radius` above the ground, stacked in
-/// height (`rise` metres per body), with random orientations, small sideways velocities and
-/// spins (paper Figures 1, 5, 6).
-inline bool drop_cylinder(WorldCore3& w, ShapeId shape, long n, float radius, float base, float rise, Pcg32& rng)
-{
-  for (long i = 0; i < n; ++i) {
-    BodyDef3 b;
-    b.shape = shape;
-    const float a = rng.uniform(0, 6.2831853f);
-    const float r = radius * std::sqrt(rng.uniform());
-    const float z = base + rise * float(i) + rng.uniform(0, rise);
-    b.position = Vector3(r * std::cos(a), r * std::sin(a), z);
-    const float ax = rng.uniform(-1, 1), ay = rng.uniform(-1, 1), az = rng.uniform(-1, 1);
-    const float angle = rng.uniform(0, 3.14159265f);
-    const Vector3 axis = Vector3(ax, ay, az).norm() > 1e-3f ? Vector3(ax, ay, az).normalized() : Vector3(0, 0, 1);
-    b.orientation = Quaternion(Eigen::AngleAxisf(angle, axis));
-    const float vx = rng.uniform(-0.5f, 0.5f), vy = rng.uniform(-0.5f, 0.5f);
-    b.linear_velocity = Vector3(vx, vy, 0);
-    const float wx = rng.uniform(-5, 5), wy = rng.uniform(-5, 5), wz = rng.uniform(-5, 5);
-    b.angular_velocity = Vector3(wx, wy, wz);
-    const Status s = w.add_body(b).status;
-    if (s != Status::ok) {
-      std::fprintf(stderr, "add_body: %s\n", to_string(s));
-      return false;
-    }
-  }
-  return true;
-}
-
 /// Steps the world (at most o.steps, stopping early once every body sleeps), writing frames if
 /// asked. Returns the mean milliseconds per step, or a negative value on error.
 inline double run(WorldCore3& w, const Options& o, int& steps_done)
@@ -93,7 +59,7 @@ inline double run(WorldCore3& w, const Options& o, int& steps_done)
       std::fprintf(stderr, "cannot write %s\n", o.frames);
       return -1;
     }
-    std::fprintf(f, "frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius\n");
+    statsim::tools::scenes::write_frames_header(f);
   }
   const float dt = 1.0f / 60;
   double seconds = 0;
@@ -104,14 +70,7 @@ inline double run(WorldCore3& w, const Options& o, int& steps_done)
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++steps_done;
     if (r.overflow) std::fprintf(stderr, "step %d: pair buffer overflow, %u pairs dropped\n", s, r.pairs_dropped);
-    if (f && s % o.every == 0)
-      for (std::uint32_t i = 0; i < w.body_count(); ++i) {
-        const Body3& b = w.body(i);
-        std::fprintf(f, "%d,%.5f,%u,%s,%.6f,%.6f,%.6f,%.7f,%.7f,%.7f,%.7f,%d,%.6f\n", s, double(s + 1) * double(dt), i,
-                     w.shape(b.shape).statistical ? w.shape(b.shape).signature.name : "sphere", double(b.position.x()), double(b.position.y()),
-                     double(b.position.z()), double(b.orientation.w()), double(b.orientation.x()),
-                     double(b.orientation.y()), double(b.orientation.z()), int(b.state), double(b.radius));
-      }
+    if (f && s % o.every == 0) statsim::tools::scenes::write_frame(f, w, s, double(s + 1) * double(dt));
   }
   if (f) std::fclose(f);
   return steps_done ? 1e3 * seconds / steps_done : 0;
@@ -139,6 +98,52 @@ inline void summary(const char* name, const WorldCore3& w, ShapeId shape, int st
                 100.0 * double(sig.rest.frequencies[p]), hist[p]);
   }
   std::printf("    on other bodies or not asleep: %u\n", none);
+}
+
+/// The demos' scene in the empty world `w` (tools/scenes/drop_pattern.hpp: drop_on_ground):
+/// `sig`'s bodies dropped from `drop` onto the ground, from the random stream (def.seed, stream).
+/// Sets `shape`; on failure prints the status and returns false.
+inline bool drop(const char* name, WorldCore3& w, const WorldDef3& def, const SignatureView<3>& sig,
+                 const tools::scenes::CylinderDrop& drop, std::uint64_t stream, ShapeId& shape)
+{
+  const Added<ShapeId> added = tools::scenes::drop_on_ground(w, def, sig, drop, stream);
+  if (!added.ok()) {
+    std::fprintf(stderr, "%s: %s\n", name, to_string(added.status));
+    return false;
+  }
+  shape = added.id;
+  return true;
+}
+
+/// A plain drop demo: its name, its table, and where its bodies fall from.
+struct DropDemo {
+  const char* name;
+  SignatureView<3> signature;
+  tools::scenes::CylinderDrop drop;  ///< `count` is the default of --n
+};
+
+/// The main of a plain drop demo: parses the options (--n at most the world's capacity), drops
+/// the bodies with the seed given, runs and prints the summary. Returns the exit code.
+inline int drop_main(int argc, char** argv, WorldCore3& w, const DropDemo& d)
+{
+  char usage[160];
+  std::snprintf(usage, sizeof usage, "%s [--n N<=%u] [--frames FILE.csv] [--every K] [--steps S] [--seed S]", d.name,
+                w.body_capacity());
+  Options o;
+  o.n = d.drop.count;
+  if (!parse(argc, argv, o, usage)) return 2;
+  if (o.n < 1 || o.n > long(w.body_capacity())) return 2;
+  WorldDef3 def;
+  def.seed = o.seed;
+  tools::scenes::CylinderDrop drop = d.drop;
+  drop.count = o.n;
+  ShapeId shape = 0;
+  if (!demo::drop(d.name, w, def, d.signature, drop, 0, shape)) return 1;
+  int steps = 0;
+  const double ms = run(w, o, steps);
+  if (ms < 0) return 1;
+  summary(d.name, w, shape, steps, ms);
+  return 0;
 }
 
 }  // namespace demo

@@ -7,7 +7,8 @@
 //     --png     picture of the final frame (default drop2d.png; "-" for none)
 //     --seed    seed of the initial states and of the world (default 1)
 //     --frames  per-frame transforms, every K-th step (default 6), in the demos' CSV format
-//               (examples/demo.hpp): x, y with y up, z = 0, the turn as a quaternion about z
+//               (tools/scenes/frames.hpp): x, y with y up, z = 0, the turn as a quaternion about z
+#include "scenes/frames.hpp"
 #include "statsim/world2.hpp"
 #include "tables/lshape2d.hpp"
 #include "tables/square2d.hpp"
@@ -158,7 +159,7 @@ int main(int argc, char** argv)
       std::fprintf(stderr, "drop2d: cannot write %s\n", frames);
       return 1;
     }
-    std::fprintf(csv, "frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius\n");
+    statsim::tools::scenes::write_frames_header(csv);
   }
   const float dt = 1.0f / 60;
   const int max_steps = 60 * 40;
@@ -168,15 +169,7 @@ int main(int argc, char** argv)
     const auto t0 = std::chrono::steady_clock::now();
     const StepResult r = world.step(dt);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (csv && steps % every == 0)
-      for (std::uint32_t i = 0; i < world.body_count(); ++i) {
-        const Body2& b = world.body(i);
-        // A turn by angle a about z: quaternion (cos a/2, 0, 0, sin a/2).
-        const double half = 0.5 * double(b.orientation.angle());
-        std::fprintf(csv, "%d,%.5f,%u,%s,%.6f,%.6f,0,%.7f,0,0,%.7f,%d,%.6f\n", steps, double(steps + 1) * double(dt), i,
-                     world.shape(b.shape).signature.name, double(b.position.x()), double(b.position.y()),
-                     std::cos(half), std::sin(half), int(b.state), double(b.radius));
-      }
+    if (csv && steps % every == 0) statsim::tools::scenes::write_frame(csv, world, steps, double(steps + 1) * double(dt));
     ++steps;
     if (r.overflow) std::fprintf(stderr, "drop2d: pair buffer overflow (%u dropped)\n", r.pairs_dropped);
   }

@@ -10,21 +10,7 @@ statsim::World3<2000> world;
 
 int main(int argc, char** argv)
 {
-  demo::Options o;
-  o.n = 300;
-  if (!demo::parse(argc, argv, o, "drop_lshapes [--n N<=2000] [--frames FILE.csv] [--every K] [--steps S] [--seed S]"))
-    return 2;
-  if (o.n < 1 || o.n > 2000) return 2;
-  statsim::WorldDef3 def;
-  def.seed = o.seed;
-  world.configure(def);
-  const statsim::ShapeId shape = world.add_shape(statsim::tables::lshape.view()).id;
-  world.add_plane(statsim::Vector3(0, 0, 1), 0);
-  statsim::Pcg32 rng(o.seed, 0);
-  if (!demo::drop_cylinder(world, shape, o.n, 0.4f, 0.3f, 0.012f, rng)) return 1;
-  int steps = 0;
-  const double ms = demo::run(world, o, steps);
-  if (ms < 0) return 1;
-  demo::summary("drop_lshapes", world, shape, steps, ms);
-  return 0;
+  // 300 L-shapes from a cylinder of radius 0.4 m, from 0.3 m up, one every 12 mm of height.
+  return demo::drop_main(argc, argv, world,
+                         {"drop_lshapes", statsim::tables::lshape.view(), {300, 0.4f, 0.3f, 0.012f}});
 }

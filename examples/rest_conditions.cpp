@@ -8,6 +8,9 @@
 #include "demo.hpp"
 #include "tables/bunny.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace {
 statsim::World3<1> worlds[2];
 }
@@ -31,11 +34,9 @@ int main(int argc, char** argv)
     def.seed = o.seed;
     def.rest_conditions = k == 1;
     statsim::World3<1>& w = worlds[k];
-    w.configure(def);
-    const statsim::ShapeId shape = w.add_shape(sig).id;
-    w.add_plane(statsim::Vector3(0, 0, 1), 0);
-    statsim::Pcg32 rng(o.seed, 7);
-    if (!demo::drop_cylinder(w, shape, 1, 0.0f, 0.6f, 0.0f, rng)) return 1;
+    // One bunny on the cylinder's axis at 0.6 m.
+    statsim::ShapeId shape = 0;
+    if (!demo::drop("rest_conditions", w, def, sig, {1, 0.0f, 0.6f, 0.0f}, 7, shape)) return 1;
     int steps = 0;
     demo::Options run = o;
     run.steps = 60 * 30;

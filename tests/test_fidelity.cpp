@@ -5,6 +5,8 @@
 #include "ref3d/ref3d.hpp"
 #include "ref3d/signature_json.hpp"
 
+#include "support/table_header.hpp"
+#include "support/temp_dir.hpp"
 #include "tables/box.hpp"
 
 #include <CLI/CLI.hpp>
@@ -15,43 +17,17 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace statsim::tools;
 using namespace statsim::tools::fidelity;
 
+using namespace statsim::testing;
+
 namespace {
-
-struct TempDir {
-  fs::path path;
-  TempDir()
-  {
-    std::string tmpl = (fs::temp_directory_path() / "statsim-test-fidelity-XXXXXX").string();
-    char* p = ::mkdtemp(tmpl.data());
-    REQUIRE(p != nullptr);
-    path = p;
-  }
-  ~TempDir()
-  {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
-
-std::string read(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::vector<double> sample(std::size_t n, double offset, unsigned salt)
 {
@@ -75,26 +51,6 @@ int run_cli(const std::vector<std::string>& args)
     return app.exit(e);
   }
   return 0;
-}
-
-// Numbers of a generated header's initializer in order: hex floats, and integers (i16 values
-// and the axis count).
-struct HeaderNumbers {
-  std::vector<double> floats;
-  std::vector<long> ints;
-};
-HeaderNumbers header_numbers(const std::string& text)
-{
-  HeaderNumbers n;
-  const std::size_t start = text.find("= {");
-  REQUIRE(start != std::string::npos);
-  std::string body = std::regex_replace(text.substr(start), std::regex("//[^\n]*"), "");
-  const std::regex token("(-?0x[0-9a-fA-Fp.+-]+)f|(-?[0-9]+)u?");
-  for (auto it = std::sregex_iterator(body.begin(), body.end(), token); it != std::sregex_iterator(); ++it) {
-    if ((*it)[1].matched) n.floats.push_back(std::strtod((*it)[1].str().c_str(), nullptr));
-    else n.ints.push_back(std::strtol((*it)[2].str().c_str(), nullptr, 10));
-  }
-  return n;
 }
 
 // The loaded signature's numbers in the generated header's order.
@@ -236,7 +192,7 @@ TEST_CASE("fidelity: compare gives zero for a sample against itself and more for
 
 TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run")
 {
-  TempDir dir;
+  TempDir dir("fidelity");
   for (const char* precision : {"f32", "i16"}) {
     CAPTURE(precision);
     const std::string hpp = dir.file(std::string("tiny_") + precision + ".hpp");
@@ -252,7 +208,7 @@ TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run
     const LoadedSignature3 s = load_signature_json(js);
     CHECK(s.name == "tinybox");
     CHECK(s.i16 == (std::string(precision) == "i16"));
-    const HeaderNumbers header = header_numbers(read(hpp));
+    const HeaderNumbers header = header_numbers(read_file(hpp));
     const HeaderNumbers loaded = loaded_numbers(s);
     REQUIRE(header.floats.size() == loaded.floats.size());
     for (std::size_t i = 0; i < header.floats.size(); ++i) {
@@ -287,7 +243,7 @@ TEST_CASE("fidelity: bad signature JSON is rejected with a message")
 
 TEST_CASE("fidelity: a tiny run writes every key, and the reference against itself is zero")
 {
-  TempDir dir;
+  TempDir dir("fidelity");
   const std::string json_path = dir.file("fid.json");
   const std::string chart_path = dir.file("fid.png");
   const std::string bytes_path = dir.file("bytes.png");
@@ -297,7 +253,7 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
                    "1/120", "--reference-dt", "1/120", "--reference", "bench", "--bench-n", "4",
                    "--bench-steps", "5", "--bootstrap", "20", "--threads", "2", "--json", json_path, "--chart",
                    chart_path, "--chart-bytes", bytes_path, "--quiet"}) == 0);
-  const nlohmann::json j = nlohmann::json::parse(read(json_path));
+  const nlohmann::json j = nlohmann::json::parse(read_file(json_path));
   REQUIRE(j.contains("methods"));
   REQUIRE(j.contains("noise_floor"));
   CHECK(j.at("summary_error_definition").get<std::string>().find("mean of the five") != std::string::npos);
@@ -364,12 +320,12 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
 
 TEST_CASE("fidelity: the gathering's reference drops a box to rest on a face")
 {
-  TempDir dir;
+  TempDir dir("fidelity");
   const std::string json_path = dir.file("gather.json");
   REQUIRE(run_cli({"--shape", "box", "--runs", "6", "--no-piles", "--methods", "statistical", "--reference",
                    "gather", "--reference-dt", "1/500", "--no-timing", "--bootstrap", "10", "--threads", "2",
                    "--json", json_path, "--quiet"}) == 0);
-  const nlohmann::json j = nlohmann::json::parse(read(json_path));
+  const nlohmann::json j = nlohmann::json::parse(read_file(json_path));
   CHECK(j.at("options").at("reference").get<std::string>() == "gather");
   const nlohmann::json& ref = j.at("reference");
   CHECK(ref.at("reference").get<std::string>() == "gather");
@@ -394,7 +350,7 @@ TEST_CASE("fidelity: the gathering's reference drops a box to rest on a face")
 
 TEST_CASE("fidelity: bad options fail before any run")
 {
-  TempDir dir;
+  TempDir dir("fidelity");
   const std::string json_path = dir.file("bad.json");
   CHECK(run_cli({"--shape", "box", "--methods", "low", "--runs", "2", "--no-piles", "--quiet", "--json", json_path}) != 0);
   CHECK(run_cli({"--shape", "box", "--methods", "nonsense", "--quiet"}) != 0);

@@ -5,8 +5,7 @@
 #include "common/parallel.hpp"
 #include "common/plot.hpp"
 #include "ref2d/fig3.hpp"
-
-#include <unistd.h>
+#include "support/temp_dir.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -20,6 +19,8 @@
 #include <vector>
 
 using namespace statsim::tools;
+
+using namespace statsim::testing;
 
 namespace {
 
@@ -55,32 +56,6 @@ double brute_force_height(const Fig3Drop& d, double speed)
     }
   }
   return -1.0;
-}
-
-struct TempDir {
-  std::filesystem::path path;
-  TempDir()
-      : path(std::filesystem::temp_directory_path() / ("statsim-test-fig3-" + std::to_string(::getpid())))
-  {
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  std::vector<std::string> files() const
-  {
-    std::vector<std::string> names;
-    for (const auto& e : std::filesystem::directory_iterator(path)) {
-      names.push_back(e.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-};
-
-std::string read_all(const std::filesystem::path& p)
-{
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
@@ -221,16 +196,16 @@ bool contains(const std::string& text, const std::string& part)
 
 TEST_CASE("fig3: writes the CSV and draws the PNG and the SVG from it")
 {
-  TempDir dir;
+  TempDir dir("fig3");
   Fig3Options o = small_config(2);
   o.trials_per_ratio = {20, 20, 20, 20};
   write_fig3_outputs(run_fig3(o), dir.path);
-  CHECK(dir.files() == std::vector<std::string>{"fig3.csv", "fig3.png", "fig3.svg"});
-  const std::string csv = read_all(dir.path / "fig3.csv");
+  CHECK(dir.entries() == std::vector<std::string>{"fig3.csv", "fig3.png", "fig3.svg"});
+  const std::string csv = read_file(dir.path / "fig3.csv");
   CHECK(csv.rfind("ratio,min,mean,std,max,trials\n0,", 0) == 0);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 5);
-  CHECK(is_png(read_all(dir.path / "fig3.png")));
-  const std::string svg = read_all(dir.path / "fig3.svg");
+  CHECK(is_png(read_file(dir.path / "fig3.png")));
+  const std::string svg = read_file(dir.path / "fig3.svg");
   CHECK(contains(svg, "<svg"));
   CHECK(contains(svg, "height of centre at first contact (m)"));
   CHECK(contains(svg, "min .. max of 20 drops"));  // the trial count comes from the CSV
@@ -238,21 +213,21 @@ TEST_CASE("fig3: writes the CSV and draws the PNG and the SVG from it")
 
 TEST_CASE("toolkit: a plotting script draws the same PNG and SVG from the same data, and fails clearly")
 {
-  TempDir dir;
+  TempDir dir("plot");
   const std::string csv = "ratio,min,mean,std,max,trials\n"
                           "0,0.501,0.635,0.064,0.7071,400\n"
                           "8,0.59,0.66,0.03,0.7071,400\n"
                           "64,0.686,0.697,0.006,0.7071,400\n";
   plot::run_script_on("fig3.py", csv, ".csv", {"--out", (dir.path / "a.png").string()});
   plot::run_script_on("fig3.py", csv, ".csv", {"--out", (dir.path / "b.svg").string()});  // either name
-  CHECK(dir.files() == std::vector<std::string>{"a.png", "a.svg", "b.png", "b.svg"});
-  const std::string png = read_all(dir.path / "a.png");
-  const std::string svg = read_all(dir.path / "a.svg");
+  CHECK(dir.entries() == std::vector<std::string>{"a.png", "a.svg", "b.png", "b.svg"});
+  const std::string png = read_file(dir.path / "a.png");
+  const std::string svg = read_file(dir.path / "a.svg");
   CHECK(is_png(png));
   CHECK(contains(svg, "height of centre at first contact (m)"));
   // No date, version or random id in either file: reruns are byte-identical.
-  CHECK(png == read_all(dir.path / "b.png"));
-  CHECK(svg == read_all(dir.path / "b.svg"));
+  CHECK(png == read_file(dir.path / "b.png"));
+  CHECK(svg == read_file(dir.path / "b.svg"));
   CHECK(plot::svg_of(dir.path / "a.png") == dir.path / "a.svg");
 
   // A missing input, a file that is not the expected CSV, an unknown output kind: the script's
@@ -276,7 +251,7 @@ TEST_CASE("toolkit: a plotting script draws the same PNG and SVG from the same d
   CHECK(contains(e, ".png or .svg"));
   CHECK(contains(error_of("no-such-script.py", {}), "not found"));
   std::filesystem::remove(dir.path / "other.csv");
-  CHECK(dir.files() == std::vector<std::string>{"a.png", "a.svg", "b.png", "b.svg"});
+  CHECK(dir.entries() == std::vector<std::string>{"a.png", "a.svg", "b.png", "b.svg"});
 
   // No interpreter with matplotlib: the message says how to get one.
   ::setenv("STATSIM_PYTHON", "/nonexistent/python3", 1);

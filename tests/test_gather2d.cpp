@@ -5,21 +5,14 @@
 #include "ref2d/compare2d.hpp"
 #include "ref2d/gather2d.hpp"
 #include "ref2d/polygon2d.hpp"
+#include "support/temp_dir.hpp"
 
 #include "statsim/world2.hpp"
 
-#if __has_include("tables/square2d.hpp")
-#include "tables/square2d.hpp"
-#define TEST_HAVE_SQUARE2D 1
-#endif
-#if __has_include("tables/lshape2d.hpp")
 #include "tables/lshape2d.hpp"
-#define TEST_HAVE_LSHAPE2D 1
-#endif
+#include "tables/square2d.hpp"
 
 #include <CLI/CLI.hpp>
-
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -31,6 +24,8 @@
 #include <vector>
 
 using namespace statsim::tools;
+
+using namespace statsim::testing;
 
 namespace {
 
@@ -52,32 +47,6 @@ Gather2dOptions tiny(unsigned threads)
   o.rest_drops = 20;
   o.threads = threads;
   return o;
-}
-
-struct TempDir {
-  std::filesystem::path path;
-  TempDir()
-      : path(std::filesystem::temp_directory_path() / ("statsim-test-gather2d-" + std::to_string(::getpid())))
-  {
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  std::size_t count() const
-  {
-    std::size_t n = 0;
-    for (const auto& e : std::filesystem::directory_iterator(path)) {
-      (void)e;
-      ++n;
-    }
-    return n;
-  }
-};
-
-std::string read_all(const std::filesystem::path& p)
-{
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 // Runs `statsim ARGS...` through the real command registration; returns the exit code.
@@ -279,26 +248,25 @@ TEST_CASE("gather2d: the L rests on its two arms and on its two tips")
 
 TEST_CASE("gather2d: the command rejects bad input with an error and writes nothing")
 {
-  TempDir dir;
+  TempDir dir("gather2d");
   const std::string out = (dir.path / "bad2d.hpp").string();
   CHECK(run_command({"gather2d", "--polygon", "0,0 1,1 1,0 0,1", "--out", out}) != 0);
   CHECK(run_command({"gather2d", "--polygon", "0,0 1,0", "--out", out}) != 0);
   CHECK(run_command({"gather2d", "--shape", "square", "--polygon", "0,0 1,0 1,1", "--out", out}) != 0);
   CHECK(run_command({"gather2d", "--shape", "square", "--out", out, "--name", "not an identifier"}) != 0);
   CHECK(run_command({"gather2d", "--shape", "square", "--out", (dir.path / "missing" / "x2d.hpp").string()}) != 0);
-  CHECK(dir.count() == 0);
+  CHECK(dir.entries().size() == 0);
 
   // A good polygon through the same path: the header records the command with the output path as
   // given, quoted for the shell.
   CHECK(run_command({"gather2d", "--polygon", "0,0 1,0 1,1 0.5,0.3 0,1", "--out", out, "--trials", "2",
                      "--height-trials", "2", "--rest-drops", "20", "--threads", "2"}) == 0);
-  const std::string header = read_all(out);
+  const std::string header = read_file(out);
   CHECK(header.find("// command: build/bin/statsim gather2d --polygon '0,0 1,0 1,1 0.5,0.3 0,1' --out " + out +
                     " --trials 2 --height-trials 2 --rest-drops 20\n") != std::string::npos);
-  CHECK(dir.count() == 1);  // no temporary file left behind
+  CHECK(dir.entries().size() == 1);  // no temporary file left behind
 }
 
-#ifdef TEST_HAVE_SQUARE2D
 TEST_CASE("gather2d: the committed square table is sane")
 {
   check_committed_table(statsim::tables::square2d, 0.5, kHalfDiagonal, 4);
@@ -319,27 +287,30 @@ TEST_CASE("gather2d: the committed square table is sane")
     }
   }
 }
-#endif
 
-#ifdef TEST_HAVE_LSHAPE2D
 TEST_CASE("gather2d: the committed L table is sane")
 {
   const Shape2 l = lshape_shape();
   check_committed_table(statsim::tables::lshape2d, l.inradius_min, l.bounding_radius, 3);
 }
-#endif
+
+namespace {
+// compare2d's options for `drops` drops, each run once (the square table is committed).
+Compare2dOptions compare_options(int drops)
+{
+  REQUIRE(compare2d_has_table("square"));
+  Compare2dOptions o;
+  o.drops = drops;
+  o.repeat = 1;
+  return o;
+}
+}  // namespace
 
 TEST_CASE("compare2d: a small drop runs in both simulations and gives finite distances")
 {
-  if (!compare2d_has_table("square")) {
-    MESSAGE("tables/square2d.hpp not generated yet: compare2d skipped");
-    return;
-  }
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(2);
   o.n = 12;
   o.steps = 150;
-  o.drops = 2;
-  o.repeat = 1;
   const Compare2dResult r = run_compare2d(o);
   // Two drops pooled: every body of both is in the final states.
   REQUIRE(r.box2d.final.size() == 24);
@@ -374,15 +345,9 @@ TEST_CASE("compare2d: a small drop runs in both simulations and gives finite dis
 
 TEST_CASE("compare2d: pooled drops are the drops run one by one")
 {
-  if (!compare2d_has_table("square")) {
-    MESSAGE("tables/square2d.hpp not generated yet: compare2d skipped");
-    return;
-  }
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(2);
   o.n = 8;
   o.steps = 120;
-  o.repeat = 1;
-  o.drops = 2;
   const Compare2dResult both = run_compare2d(o);
   o.drops = 1;
   const Compare2dResult first = run_compare2d(o);
@@ -411,16 +376,10 @@ TEST_CASE("compare2d: pooled drops are the drops run one by one")
 
 TEST_CASE("compare2d: squares wedged between sleeping ones fall asleep")
 {
-  if (!compare2d_has_table("square")) {
-    MESSAGE("tables/square2d.hpp not generated yet: compare2d skipped");
-    return;
-  }
   // Seed 2 wedges squares between two sleepers, where the contact passes leave a velocity that
   // the overlap correction undoes every step: judged by |v| alone, 2 of the 100 never slept.
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(1);
   o.seed = 2;
-  o.drops = 1;
-  o.repeat = 1;
   const Compare2dResult r = run_compare2d(o);
   CHECK(r.statsim.asleep == o.n);
 }

@@ -4,7 +4,7 @@
 // (the runtime's arithmetic does not depend on the optimisation level).
 #include <doctest/doctest.h>
 
-#include "synthetic_signature.hpp"
+#include "scenes/synthetic_signatures.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"

@@ -6,6 +6,7 @@
 #include "mesh/mesh_commands.hpp"
 #include "mesh/shapes.hpp"
 #include "mesh/spheres.hpp"
+#include "support/temp_dir.hpp"
 
 #include <doctest/doctest.h>
 
@@ -22,52 +23,14 @@
 #include <string>
 #include <vector>
 
-#include <stdlib.h>  // mkdtemp
-
 namespace fs = std::filesystem;
 using namespace statsim::tools;
+
+using namespace statsim::testing;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// A fresh temporary directory, removed with its contents at scope exit.
-struct TempDir {
-  fs::path path;
-  TempDir()
-  {
-    std::string tmpl = (fs::temp_directory_path() / "statsim-test-mesh-XXXXXX").string();
-    char* p = ::mkdtemp(tmpl.data());
-    REQUIRE(p != nullptr);
-    path = p;
-  }
-  ~TempDir()
-  {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name, const std::string& content) const
-  {
-    const fs::path f = path / name;
-    std::ofstream(f, std::ios::binary) << content;
-    return f.string();
-  }
-  std::vector<std::string> entries() const
-  {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(path)) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-};
-
-std::string read(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Closed-form inertia of a solid box of unit density about its centre.
 Eigen::Vector3d box_inertia(const Eigen::Vector3d& size)
@@ -301,7 +264,7 @@ TEST_CASE("the committed meshes")
   CHECK((ls.inertia - inertia).norm() < 1e-12 * inertia.norm());
 
   // 7 spheres: "x y z r" lines after the comments.
-  std::istringstream spheres(read("tools/meshes/bunny_spheres7.txt"));
+  std::istringstream spheres(read_file("tools/meshes/bunny_spheres7.txt"));
   std::string line;
   int count = 0;
   while (std::getline(spheres, line)) {
@@ -319,7 +282,7 @@ TEST_CASE("the committed meshes")
 
 TEST_CASE("bad meshes are rejected with a message naming the problem")
 {
-  TempDir dir;
+  TempDir dir("mesh");
   struct Case {
     const char* name;
     std::string text;
@@ -360,7 +323,7 @@ TEST_CASE("bad meshes are rejected with a message naming the problem")
   };
   for (const Case& c : cases) {
     CAPTURE(c.name);
-    const std::string path = dir.file(std::string(c.name) + ".obj", c.text);
+    const std::string path = dir.write(std::string(c.name) + ".obj", c.text);
     TriMesh m;
     MeshError e;
     CHECK_FALSE(load_obj(path, m, e));
@@ -389,7 +352,7 @@ TEST_CASE("bad meshes are rejected with a message naming the problem")
 
 TEST_CASE("OBJ features: CRLF, quads, n-gons, negative indices, groups, materials, unused vertices")
 {
-  TempDir dir;
+  TempDir dir("mesh");
   const std::string cube =
     "# a cube of quads\r\nmtllib missing.mtl\r\nv -1 -1 -1\r\nv 1 -1 -1\r\nv 1 1 -1\r\nv -1 1 -1\r\n"
     "v -1 -1 1\r\nv 1 -1 1\r\nv 1 1 1\r\nv -1 1 1\r\nv 5 5 5\r\nvn 0 0 1\r\nvt 0 0\r\no cube\r\nusemtl red\r\n"
@@ -397,7 +360,7 @@ TEST_CASE("OBJ features: CRLF, quads, n-gons, negative indices, groups, material
     "f -9 -5 -2 -6\r\n";
   TriMesh m;
   MeshError e;
-  REQUIRE_MESSAGE(load_obj(dir.file("cube.obj", cube), m, e), e.message);
+  REQUIRE_MESSAGE(load_obj(dir.write("cube.obj", cube), m, e), e.message);
   CHECK(m.vertices.size() == 8);  // the unused vertex (5, 5, 5) is dropped
   CHECK(m.triangles.size() == 12);
   const MassProperties mp = compute_mass_properties(m);
@@ -409,7 +372,7 @@ TEST_CASE("OBJ features: CRLF, quads, n-gons, negative indices, groups, material
     "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
     "v 0 0 1\nv 2 0 1\nv 2 1 1\nv 1 1 1\nv 1 2 1\nv 0 2 1\n"
     "f 6 5 4 3 2 1\nf 7 8 9 10 11 12\nf 1 2 8 7\nf 2 3 9 8\nf 3 4 10 9\nf 4 5 11 10\nf 5 6 12 11\nf 6 1 7 12\n";
-  REQUIRE_MESSAGE(load_obj(dir.file("l.obj", l), m, e), e.message);
+  REQUIRE_MESSAGE(load_obj(dir.write("l.obj", l), m, e), e.message);
   CHECK(m.triangles.size() == 20);
   CHECK(compute_mass_properties(m).volume == doctest::Approx(3.0));
   CHECK((compute_mass_properties(m).com - Eigen::Vector3d(5.0 / 6.0, 5.0 / 6.0, 0.5)).norm() < 1e-12);
@@ -428,12 +391,12 @@ TEST_CASE("OBJ features: CRLF, quads, n-gons, negative indices, groups, material
 
 TEST_CASE("mesh commands: outputs, determinism, and no output file on failure")
 {
-  TempDir dir;
+  TempDir dir("mesh");
   std::ostringstream out, err;
 
   // Bad inputs: non-zero exit, the message, and nothing written (no output, no temporary).
-  const std::string open = dir.file("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n");
-  const std::string nan = dir.file("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 NaN\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n");
+  const std::string open = dir.write("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n");
+  const std::string nan = dir.write("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 NaN\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n");
   const auto before = dir.entries();
   const std::string target = (dir.path / "out.obj").string();
   for (const std::string& bad : {open, nan, (dir.path / "missing.obj").string()}) {
@@ -458,9 +421,9 @@ TEST_CASE("mesh commands: outputs, determinism, and no output file on failure")
   CHECK(err.str().find("cannot create output file") != std::string::npos);
   CHECK(dir.entries() == before);
   // A failing command leaves an existing output untouched.
-  const std::string existing = dir.file("existing.obj", "keep");
+  const std::string existing = dir.write("existing.obj", "keep");
   CHECK(mesh_decimate(open, existing, 100, out, err) != 0);
-  CHECK(read(existing) == "keep");
+  CHECK(read_file(existing) == "keep");
 
   // Good runs: the box and the L-shape load back with the right volumes.
   const std::string box = (dir.path / "box.obj").string();
@@ -469,7 +432,7 @@ TEST_CASE("mesh commands: outputs, determinism, and no output file on failure")
   MeshError e;
   REQUIRE(load_obj(box, m, e));
   CHECK(compute_mass_properties(m).volume == doctest::Approx(8.0));
-  CHECK(read(box).find("# Regenerate: build/bin/statsim mesh box --size 1,2,4 --out " + box) != std::string::npos);
+  CHECK(read_file(box).find("# Regenerate: build/bin/statsim mesh box --size 1,2,4 --out " + box) != std::string::npos);
 
   // The committed derived meshes are what the current code generates (up to the output path in
   // the header): regenerate into the temporary directory and compare.
@@ -495,15 +458,15 @@ TEST_CASE("mesh commands: outputs, determinism, and no output file on failure")
     CAPTURE(committed);
     const std::string fresh = (dir.path / fs::path(committed).filename()).string();
     REQUIRE(generate(fresh) == 0);
-    const std::string a = strip(read(committed), committed);
-    const std::string b = strip(read(fresh), fresh);
+    const std::string a = strip(read_file(committed), committed);
+    const std::string b = strip(read_file(fresh), fresh);
     CHECK(a.size() > 100);
     CHECK(a == b);
     // Twice gives the same bytes (the sphere fit, the slow one, is compared with the committed file only).
     if (committed.find("spheres") == std::string::npos) {
-      const std::string first = read(fresh);
+      const std::string first = read_file(fresh);
       REQUIRE(generate(fresh) == 0);
-      CHECK(read(fresh) == first);
+      CHECK(read_file(fresh) == first);
     }
   }
 }

@@ -6,7 +6,7 @@
 // EIGEN_RUNTIME_NO_MALLOC, so any Eigen heap allocation asserts while it is disallowed.
 #include <doctest/doctest.h>
 
-#include "synthetic_signature.hpp"
+#include "scenes/synthetic_signatures.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"

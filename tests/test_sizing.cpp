@@ -5,20 +5,16 @@
 #include "mesh/shapes.hpp"
 #include "ref3d/gather.hpp"
 #include "ref3d/sizing.hpp"
+#include "support/temp_dir.hpp"
 
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <stdlib.h>  // mkdtemp
-
-namespace fs = std::filesystem;
 using namespace statsim::tools;
 using namespace statsim::tools::ref3d;
 
@@ -244,26 +240,17 @@ TEST_CASE("sizing: the sized table is the chosen subset, and says so in its head
 
 TEST_CASE("held-out wedge: the committed OBJ is what its command writes, closed and outward")
 {
-  char tmpl[] = "/tmp/statsim_wedge_XXXXXX";
-  REQUIRE(mkdtemp(tmpl) != nullptr);
-  const fs::path dir = tmpl;
+  const statsim::testing::TempDir dir("wedge");
   std::ostringstream out, err;
-  const std::string path = (dir / "wedge.obj").string();
+  const std::string path = dir.file("wedge.obj");
   REQUIRE(mesh_wedge(0.2, 0.1, 0.08, path, out, err) == 0);
-  auto read = [](const std::string& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-  };
-  std::string want = read("tools/meshes/wedge.obj"), got = read(path);
+  std::string want = statsim::testing::read_file("tools/meshes/wedge.obj"), got = statsim::testing::read_file(path);
   // The command names its output file; the committed one was written to tools/meshes/wedge.obj.
   const std::string needle = path;
   for (std::size_t at = got.find(needle); at != std::string::npos; at = got.find(needle))
     got.replace(at, needle.size(), "tools/meshes/wedge.obj");
   CHECK(got == want);
-  CHECK(mesh_wedge(0.2, -0.1, 0.08, (dir / "bad.obj").string(), out, err) != 0);
-  fs::remove_all(dir);
+  CHECK(mesh_wedge(0.2, -0.1, 0.08, dir.file("bad.obj"), out, err) != 0);
 
   const TriMesh m = make_wedge(0.2, 0.1, 0.08);
   CHECK(m.vertices.size() == 6);

@@ -1,6 +1,6 @@
 #include <doctest/doctest.h>
 
-#include "synthetic_signature.hpp"
+#include "scenes/synthetic_signatures.hpp"
 
 #include "statsim/statistical.hpp"
 #include "tables/bunny.hpp"

@@ -11,6 +11,7 @@
 // The world is small (16 bodies, 4 planes, 24 pairs) so capacity limits and pair overflow are hit.
 #include "fuzz_input.hpp"
 
+#include "scenes/synthetic_signatures.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 #include "tables/box.hpp"
@@ -18,7 +19,6 @@
 #include "tables/lshape.hpp"
 #include "tables/lshape2d.hpp"
 #include "tables/square2d.hpp"
-#include "../synthetic_signature.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -114,7 +114,7 @@ struct Body3 {
   std::string sphere_radius_note;         ///< where it comes from
   Surface surface;
   bool has_table = false;                 ///< a statistical table is compiled in for the shape
-  bool synthetic_table = false;           ///< the table is tests/synthetic_signature.hpp's cube
+  bool synthetic_table = false;           ///< the table is tools/scenes/synthetic_signatures.hpp's cube
   std::string table_name;
 };
 

@@ -22,7 +22,7 @@
 #include "tables/square2d.hpp"
 #define STATSIM_BENCH_HAVE_SQUARE2D 1
 #endif
-#include "../../tests/synthetic_signature.hpp"
+#include "scenes/synthetic_signatures.hpp"
 
 #include <cmath>
 #include <memory>
@@ -244,7 +244,7 @@ void describe_table3(const std::string& shape, bool allow_synthetic, Body3& body
     return;
   }
   body.synthetic_table = t->synthetic;
-  body.table_name = t->synthetic ? "tests/synthetic_signature.hpp cube_synthetic (stand-in: tables/" + shape +
+  body.table_name = t->synthetic ? "tools/scenes/synthetic_signatures.hpp cube_synthetic (stand-in: tables/" + shape +
                                        ".hpp is missing)"
                                  : "tables/" + shape + ".hpp";
   fill_surface<3>(t->view, body.surface);
@@ -264,7 +264,7 @@ void describe_table2(bool allow_synthetic, Body2& body)
   }
   body.synthetic_table = view2_synthetic();
   body.table_name = body.synthetic_table
-                        ? "tests/synthetic_signature.hpp square2d_synthetic (stand-in: tables/square2d.hpp is missing)"
+                        ? "tools/scenes/synthetic_signatures.hpp square2d_synthetic (stand-in: tables/square2d.hpp is missing)"
                         : "tables/square2d.hpp";
   fill_surface<2>(*v, body.surface);
   body.mass = static_cast<double>(v->mass);

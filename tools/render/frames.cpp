@@ -17,15 +17,6 @@ int Frames::body_count() const
   return n;
 }
 
-const char* frames_header() { return "frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius"; }
-
-void write_frame_row(std::FILE* f, int step, double time, int body, const std::string& shape,
-                     const Eigen::Vector3d& x, const Eigen::Quaterniond& q, int state, double radius)
-{
-  std::fprintf(f, "%d,%.5f,%d,%s,%.6f,%.6f,%.6f,%.7f,%.7f,%.7f,%.7f,%d,%.6f\n", step, time, body, shape.c_str(), x.x(),
-               x.y(), x.z(), q.w(), q.x(), q.y(), q.z(), state, radius);
-}
-
 namespace {
 
 std::vector<std::string> split(const std::string& line)

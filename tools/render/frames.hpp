@@ -1,26 +1,17 @@
-// Frame files: per-frame body transforms, the one format the demos (examples/demo.hpp), the
-// reference runs (`statsim reference-run`) and the picture tools (`statsim render`, `statsim
-// export`) share.
+// Frame files: per-frame body transforms, the one format the demos (examples/), the reference
+// runs (`statsim reference-run`) and the picture tools (`statsim render`, `statsim export`)
+// share. The format and its one writer are in tools/scenes/frames.hpp; this is the reader.
 //
-// CSV with the header line
-//   frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius
-// and one row per body per written frame:
-//   frame   step index (integer; rows of one frame are consecutive)
-//   time    s, simulated time after that step
-//   body    body index (integer, 0-based)
-//   shape   the shape's name: box, lshape, bunny (3D); square2d, lshape2d (2D); sphere. A plain
-//           integer (a shape id, as older files wrote) is accepted and mapped by the caller.
-//   x y z   centre of mass, m, world frame, z up (2D runs: x, y with y up, z = 0)
-//   qw..qz  orientation, unit quaternion, body to world (2D runs: a turn about z)
-//   state   0 moving, 1 settling, 2 asleep
-//   radius  collision-sphere radius, m (optional column; 0 or absent: unknown)
-// Lines starting with '#' are comments.
+// Besides the files that writer writes, the reader accepts files without the radius column
+// (radius 0: unknown), a plain integer as the shape (a shape id, as older files wrote, mapped by
+// the caller), and lines starting with '#' (comments).
 #pragma once
+
+#include "scenes/frames.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -59,10 +50,8 @@ bool read_frames(const std::string& path, const std::vector<std::string>& shape_
 bool parse_frames(const std::string& text, const std::string& name, const std::vector<std::string>& shape_names,
                   Frames& out, std::string& error);
 
-/// The header line (without newline).
-const char* frames_header();
-/// Writes one row in the same number format as examples/demo.hpp.
-void write_frame_row(std::FILE* f, int step, double time, int body, const std::string& shape,
-                     const Eigen::Vector3d& x, const Eigen::Quaterniond& q, int state, double radius);
+/// The writer's header line and rows (tools/scenes/frames.hpp).
+using scenes::frames_header;
+using scenes::write_frame_row;
 
 }  // namespace statsim::tools::render

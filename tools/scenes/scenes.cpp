@@ -178,30 +178,38 @@ DropScene2 drop_scene2(const DropOptions& o)
   return scene;
 }
 
-std::string describe(const DropScene3& sc)
+namespace {
+
+// The description of a drop scene around its region's own words ("a cylinder of radius ...").
+template <class Scene>
+std::string describe(const Scene& sc, const char* what, const std::string& region, const char* ground,
+                     const char* spin)
 {
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "bunny drop: %zu bodies of bounding radius %.4g m in a cylinder of radius %.3g m, z from %.3g to "
-                "%.3g m (cell %.3g m), above the ground plane z = 0; velocity components in +-%.3g m/s, spin "
-                "components in +-%.3g rad/s; seed %llu",
-                sc.bodies.size(), sc.options.bounding_radius, sc.region.radius, sc.region.bottom,
-                sc.region.bottom + sc.region.height, sc.cell, sc.options.max_speed, sc.options.max_spin,
-                static_cast<unsigned long long>(sc.options.seed));
+                "%s: %zu bodies of bounding radius %.4g m in %s (cell %.3g m), above the %s; velocity components in "
+                "+-%.3g m/s, %s in +-%.3g rad/s; seed %llu",
+                what, sc.bodies.size(), sc.options.bounding_radius, region.c_str(), sc.cell, ground,
+                sc.options.max_speed, spin, sc.options.max_spin, static_cast<unsigned long long>(sc.options.seed));
   return buf;
+}
+
+}  // namespace
+
+std::string describe(const DropScene3& sc)
+{
+  char region[128];
+  std::snprintf(region, sizeof region, "a cylinder of radius %.3g m, z from %.3g to %.3g m", sc.region.radius,
+                sc.region.bottom, sc.region.bottom + sc.region.height);
+  return describe(sc, "bunny drop", region, "ground plane z = 0", "spin components");
 }
 
 std::string describe(const DropScene2& sc)
 {
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "2D drop: %zu bodies of bounding radius %.4g m in x within +-%.3g m, y from %.3g to %.3g m (cell "
-                "%.3g m), above the ground line y = 0; velocity components in +-%.3g m/s, spin in +-%.3g rad/s; "
-                "seed %llu",
-                sc.bodies.size(), sc.options.bounding_radius, sc.region.half_width, sc.region.bottom,
-                sc.region.bottom + sc.region.height, sc.cell, sc.options.max_speed, sc.options.max_spin,
-                static_cast<unsigned long long>(sc.options.seed));
-  return buf;
+  char region[128];
+  std::snprintf(region, sizeof region, "x within +-%.3g m, y from %.3g to %.3g m", sc.region.half_width,
+                sc.region.bottom, sc.region.bottom + sc.region.height);
+  return describe(sc, "2D drop", region, "ground line y = 0", "spin");
 }
 
 namespace {

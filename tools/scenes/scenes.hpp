@@ -97,21 +97,6 @@ struct Cylinder {
   double height = 0.0;  ///< m
 };
 
-struct DropScene3 {
-  DropOptions options;
-  Cylinder region;
-  double cell = 0.0;  ///< lattice cell side s, m
-  std::vector<BodyState3> bodies;
-  /// A box that holds the scene while it runs, for broad phases that need world bounds (Bullet's
-  /// btAxisSweep3): x and y within +-(3 Rc + 1 m) (the pile spreads beyond the cylinder), z from
-  /// -1 m to the region's top + 1 m.
-  Eigen::Vector3d bounds_lo = Eigen::Vector3d::Zero();
-  Eigen::Vector3d bounds_hi = Eigen::Vector3d::Zero();
-};
-
-/// The "bunny drop" scene (for any body of bounding radius `options.bounding_radius`).
-DropScene3 drop_scene3(const DropOptions& options);
-
 /// The 2D drop region: a rectangle centred on x = 0 above the ground line.
 struct Rectangle {
   double half_width = 0.0;  ///< m
@@ -119,15 +104,24 @@ struct Rectangle {
   double height = 0.0;      ///< m
 };
 
-struct DropScene2 {
+/// A drop scene: the region (Cylinder or Rectangle), the lattice and the bodies' initial states.
+template <class Region, class BodyState, int D>
+struct DropScene {
   DropOptions options;
-  Rectangle region;
-  double cell = 0.0;
-  std::vector<BodyState2> bodies;
-  Eigen::Vector2d bounds_lo = Eigen::Vector2d::Zero();  ///< x within +-(3 W + 1 m), y from -1 m
-  Eigen::Vector2d bounds_hi = Eigen::Vector2d::Zero();  ///< to the region's top + 1 m
+  Region region;
+  double cell = 0.0;  ///< lattice cell side s, m
+  std::vector<BodyState> bodies;
+  /// A box that holds the scene while it runs, for broad phases that need world bounds (Bullet's
+  /// btAxisSweep3): horizontally within +-(3 Rc + 1 m) (3D) or +-(3 W + 1 m) (2D), as the pile
+  /// spreads beyond the region; vertically from -1 m to the region's top + 1 m.
+  Eigen::Matrix<double, D, 1> bounds_lo = Eigen::Matrix<double, D, 1>::Zero();
+  Eigen::Matrix<double, D, 1> bounds_hi = Eigen::Matrix<double, D, 1>::Zero();
 };
+using DropScene3 = DropScene<Cylinder, BodyState3, 3>;
+using DropScene2 = DropScene<Rectangle, BodyState2, 2>;
 
+/// The "bunny drop" scene (for any body of bounding radius `options.bounding_radius`).
+DropScene3 drop_scene3(const DropOptions& options);
 /// The 2D drop scene (squares above a ground line in the benchmark).
 DropScene2 drop_scene2(const DropOptions& options);
 
