@@ -525,35 +525,17 @@ GatherResult gather(const GatherOptions& options)
 Quantized quantize(const std::vector<float>& values)
 {
   Quantized out;
-  if (values.empty()) return out;
-  float lo = values[0], hi = values[0];
-  for (float v : values) {
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
-  out.offset = 0.5f * (lo + hi);
-  out.scale = hi > lo ? (hi - lo) / 65534.0f : 1.0f;
-  out.q.reserve(values.size());
-  for (float v : values) {
-    const double qd = std::nearbyint((static_cast<double>(v) - out.offset) / out.scale);
-    const auto q = static_cast<std::int16_t>(std::clamp(qd, -32767.0, 32767.0));
-    out.q.push_back(q);
+  out.q.resize(values.size());
+  statsim::quantize16(values.data(), values.size(), out.scale, out.offset, out.q.data());
+  for (std::size_t i = 0; i < values.size(); ++i) {
     // As the runtime dequantises: offset + scale * Scalar(q), in float.
-    const float back = out.offset + out.scale * static_cast<float>(q);
-    out.worst_error = std::max(out.worst_error, std::fabs(static_cast<double>(back) - static_cast<double>(v)));
+    const float back = out.offset + out.scale * static_cast<float>(out.q[i]);
+    out.worst_error = std::max(out.worst_error, std::fabs(static_cast<double>(back) - static_cast<double>(values[i])));
   }
   return out;
 }
 
 namespace {
-
-std::string hexf(float x)
-{
-  if (x == 0.0f) return "0x0p+0f";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%af", static_cast<double>(x));
-  return buf;
-}
 
 std::vector<float> to_float(const std::vector<double>& v)
 {
