@@ -338,17 +338,26 @@ TEST_CASE("gather2d: the committed L table is sane")
 }
 #endif
 
+namespace {
+
+// Options of a compare2d run of `drops` drops, timed once, on the committed square table (which
+// compare2d must have compiled in).
+Compare2dOptions compare_options(int drops)
+{
+  REQUIRE(compare2d_has_table("square"));
+  Compare2dOptions o;
+  o.drops = drops;
+  o.repeat = 1;
+  return o;
+}
+
+}  // namespace
+
 TEST_CASE("compare2d: a small drop runs in both simulations and gives finite distances")
 {
-  if (!compare2d_has_table("square")) {
-    MESSAGE("tables/square2d.hpp not generated yet: compare2d skipped");
-    return;
-  }
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(2);
   o.n = 12;
   o.steps = 150;
-  o.drops = 2;
-  o.repeat = 1;
   const Compare2dResult r = run_compare2d(o);
   // Two drops pooled: every body of both is in the final states.
   REQUIRE(r.box2d.final.size() == 24);
@@ -383,15 +392,9 @@ TEST_CASE("compare2d: a small drop runs in both simulations and gives finite dis
 
 TEST_CASE("compare2d: pooled drops are the drops run one by one")
 {
-  if (!compare2d_has_table("square")) {
-    MESSAGE("tables/square2d.hpp not generated yet: compare2d skipped");
-    return;
-  }
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(2);
   o.n = 8;
   o.steps = 120;
-  o.repeat = 1;
-  o.drops = 2;
   const Compare2dResult both = run_compare2d(o);
   o.drops = 1;
   const Compare2dResult first = run_compare2d(o);
@@ -420,16 +423,10 @@ TEST_CASE("compare2d: pooled drops are the drops run one by one")
 
 TEST_CASE("compare2d: squares wedged between sleeping ones fall asleep")
 {
-  if (!compare2d_has_table("square")) {
-    MESSAGE("tables/square2d.hpp not generated yet: compare2d skipped");
-    return;
-  }
   // Seed 2 wedges squares between two sleepers, where the contact passes leave a velocity that
   // the overlap correction undoes every step: judged by |v| alone, 2 of the 100 never slept.
-  Compare2dOptions o;
+  Compare2dOptions o = compare_options(1);
   o.seed = 2;
-  o.drops = 1;
-  o.repeat = 1;
   const Compare2dResult r = run_compare2d(o);
   CHECK(r.statsim.asleep == o.n);
 }

@@ -378,6 +378,19 @@ void warm_up_box2d(const Context& ctx)
   measure_first_contact(ctx.pieces, ctx.shape.bounding_radius + 0.1, 0.0, 1.0, 0.0, 1.0 / 60.0);
 }
 
+// A result with what every run records (the options, the shape, L and the restitution threshold),
+// and Box2D ready for worker threads.
+Gather2dResult start_result(const Gather2dOptions& options, const Context& ctx)
+{
+  Gather2dResult r;
+  r.options = options;
+  r.shape = ctx.shape;
+  r.length = ctx.length;
+  r.restitution_threshold = ctx.threshold;
+  warm_up_box2d(ctx);
+  return r;
+}
+
 }  // namespace
 
 std::vector<double> default_height_ratios()
@@ -459,13 +472,8 @@ void validate_gather2d_options(const Gather2dOptions& o)
 Gather2dResult run_rest_poses(const Gather2dOptions& options)
 {
   validate_gather2d_options(options);
-  Gather2dResult r;
-  r.options = options;
   const Context ctx = make_context(options);
-  r.shape = ctx.shape;
-  r.length = ctx.length;
-  r.restitution_threshold = ctx.threshold;
-  warm_up_box2d(ctx);
+  Gather2dResult r = start_result(options, ctx);
   rest_experiment(ctx, r);
   return r;
 }
@@ -474,13 +482,8 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
 {
   validate_gather2d_options(options);
   const Gather2dOptions& o = options;
-  Gather2dResult r;
-  r.options = o;
   const Context ctx = make_context(o);
-  r.shape = ctx.shape;
-  r.length = ctx.length;
-  r.restitution_threshold = ctx.threshold;
-  warm_up_box2d(ctx);
+  Gather2dResult r = start_result(o, ctx);
 
   // 1. Height table.
   {

@@ -281,6 +281,26 @@ DropTrial drop_trial(const Reference& ref, const GatherOptions& o, std::uint64_t
   return d;
 }
 
+// The index of the centre nearest to `dir` within the angle whose cosine is `cos_tol` (the first
+// of equals), or of a new centre at `dir` when none is that near.
+int nearest_or_new(std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& dir, double cos_tol)
+{
+  int best = -1;
+  double best_c = cos_tol;
+  for (std::size_t c = 0; c < centres.size(); ++c) {
+    const double d = centres[c].dot(dir);
+    if (d >= best_c) {
+      best_c = d;
+      best = static_cast<int>(c);
+    }
+  }
+  if (best < 0) {
+    best = static_cast<int>(centres.size());
+    centres.push_back(dir);
+  }
+  return best;
+}
+
 // Clusters unit vectors: leader clustering in input order within `tol` (radians), then up to 20
 // rounds of assigning each vector to the nearest cluster mean (a new cluster when none is within
 // `tol`) until nothing moves. Returns the cluster of each vector; deterministic.
@@ -289,22 +309,7 @@ std::vector<int> cluster_directions(const std::vector<Eigen::Vector3d>& dirs, do
   const double cos_tol = std::cos(tol);
   std::vector<Eigen::Vector3d> centres;
   std::vector<int> label(dirs.size(), -1);
-  for (std::size_t i = 0; i < dirs.size(); ++i) {
-    int best = -1;
-    double best_c = cos_tol;
-    for (std::size_t c = 0; c < centres.size(); ++c) {
-      const double d = centres[c].dot(dirs[i]);
-      if (d >= best_c) {
-        best_c = d;
-        best = static_cast<int>(c);
-      }
-    }
-    if (best < 0) {
-      best = static_cast<int>(centres.size());
-      centres.push_back(dirs[i]);
-    }
-    label[i] = best;
-  }
+  for (std::size_t i = 0; i < dirs.size(); ++i) label[i] = nearest_or_new(centres, dirs[i], cos_tol);
   for (int round = 0; round < 20; ++round) {
     std::vector<Eigen::Vector3d> sum(centres.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < dirs.size(); ++i) sum[label[i]] += dirs[i];
@@ -314,20 +319,7 @@ std::vector<int> cluster_directions(const std::vector<Eigen::Vector3d>& dirs, do
     bool moved = mean.size() != centres.size();
     std::vector<int> next(dirs.size(), -1);
     for (std::size_t i = 0; i < dirs.size(); ++i) {
-      int best = -1;
-      double best_c = cos_tol;
-      for (std::size_t c = 0; c < mean.size(); ++c) {
-        const double d = mean[c].dot(dirs[i]);
-        if (d >= best_c) {
-          best_c = d;
-          best = static_cast<int>(c);
-        }
-      }
-      if (best < 0) {
-        best = static_cast<int>(mean.size());
-        mean.push_back(dirs[i]);
-      }
-      next[i] = best;
+      next[i] = nearest_or_new(mean, dirs[i], cos_tol);
       moved = moved || next[i] != label[i];
     }
     label = next;
