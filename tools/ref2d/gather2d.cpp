@@ -342,22 +342,33 @@ void cluster_rest_poses(Gather2dResult& r)
   });
 }
 
-void rest_experiment(const Context& ctx, Gather2dResult& r)
+// fn(i) for every trial i < n on the options' worker threads, in order of i, with a progress
+// line `label`.
+template <class Fn>
+auto run_trials(const char* label, std::size_t n, const Gather2dOptions& o, Fn&& fn)
 {
-  const Gather2dOptions& o = r.options;
-  const auto start = std::chrono::steady_clock::now();
-  const std::size_t n = static_cast<std::size_t>(o.rest_drops);
-  Progress progress("gather2d rest poses", n, o.progress);
-  const std::vector<RestTrial> trials = parallel_map(
+  Progress progress(label, n, o.progress);
+  auto trials = parallel_map(
       n,
       [&](std::size_t i) {
-        std::mt19937_64 rng = trial_rng(o.seed, kRestPoses, 0, i);
-        RestTrial t = simulate_rest(ctx, o, rng);
+        auto t = fn(i);
         progress.add();
         return t;
       },
       o.threads);
   progress.finish();
+  return trials;
+}
+
+void rest_experiment(const Context& ctx, Gather2dResult& r)
+{
+  const Gather2dOptions& o = r.options;
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t n = static_cast<std::size_t>(o.rest_drops);
+  const std::vector<RestTrial> trials = run_trials("gather2d rest poses", n, o, [&](std::size_t i) {
+    std::mt19937_64 rng = trial_rng(o.seed, kRestPoses, 0, i);
+    return simulate_rest(ctx, o, rng);
+  });
   r.rest_drops = static_cast<int>(n);
   r.rest_ups.clear();
   r.rest_settled.clear();
@@ -492,23 +503,16 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
     r.height_dt = step_for_spin(1.0 / 60.0, max_spin);
     const std::size_t nr = o.height_ratios.size();
     const std::size_t per = static_cast<std::size_t>(o.height_trials);
-    Progress progress("gather2d heights", nr * per, o.progress);
-    const std::vector<FirstContact> trials = parallel_map(
-        nr * per,
-        [&](std::size_t flat) {
-          const std::size_t i = flat / per, k = flat % per;
-          std::mt19937_64 rng = trial_rng(o.seed, kHeightTable, i, k);
-          const double angle = 2.0 * kPi * uniform01(rng);
-          const double sign = (rng() >> 63) != 0 ? 1.0 : -1.0;
-          const double spin = sign * o.height_ratios[i] * o.height_speed / ctx.length;
-          // Start clear of the skin and the fat-AABB margin, at a random phase of one step.
-          const double height = ctx.shape.bounding_radius + 0.1 + uniform01(rng) * o.height_speed * r.height_dt;
-          FirstContact t = measure_first_contact(ctx.pieces, height, angle, o.height_speed, spin, r.height_dt);
-          progress.add();
-          return t;
-        },
-        o.threads);
-    progress.finish();
+    const std::vector<FirstContact> trials = run_trials("gather2d heights", nr * per, o, [&](std::size_t flat) {
+      const std::size_t i = flat / per, k = flat % per;
+      std::mt19937_64 rng = trial_rng(o.seed, kHeightTable, i, k);
+      const double angle = 2.0 * kPi * uniform01(rng);
+      const double sign = (rng() >> 63) != 0 ? 1.0 : -1.0;
+      const double spin = sign * o.height_ratios[i] * o.height_speed / ctx.length;
+      // Start clear of the skin and the fat-AABB margin, at a random phase of one step.
+      const double height = ctx.shape.bounding_radius + 0.1 + uniform01(rng) * o.height_speed * r.height_dt;
+      return measure_first_contact(ctx.pieces, height, angle, o.height_speed, spin, r.height_dt);
+    });
     for (std::size_t i = 0; i < nr; ++i) {
       HeightRow row;
       row.ratio = o.height_ratios[i];
@@ -539,20 +543,13 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
     const std::size_t a0 = o.cos_thetas.size(), a1 = o.signed_spins.size(), a2 = o.speeds.size();
     const std::size_t cells = a0 * a1 * a2;
     const std::size_t per = static_cast<std::size_t>(o.trials);
-    Progress progress("gather2d responses", cells * per, o.progress);
-    const std::vector<ResponseTrial> trials = parallel_map(
-        cells * per,
-        [&](std::size_t flat) {
-          const std::size_t cell = flat / per, k = flat % per;
-          const std::size_t i = cell / (a1 * a2), j = (cell / a2) % a1, l = cell % a2;
-          std::mt19937_64 rng = trial_rng(o.seed, kResponseTable, cell, k);
-          ResponseTrial t = simulate_response(ctx, o.cos_thetas[i], o.signed_spins[j], o.speeds[l], r.response_dt,
-                                              o.response_time_limit, rng);
-          progress.add();
-          return t;
-        },
-        o.threads);
-    progress.finish();
+    const std::vector<ResponseTrial> trials = run_trials("gather2d responses", cells * per, o, [&](std::size_t flat) {
+      const std::size_t cell = flat / per, k = flat % per;
+      const std::size_t i = cell / (a1 * a2), j = (cell / a2) % a1, l = cell % a2;
+      std::mt19937_64 rng = trial_rng(o.seed, kResponseTable, cell, k);
+      return simulate_response(ctx, o.cos_thetas[i], o.signed_spins[j], o.speeds[l], r.response_dt,
+                               o.response_time_limit, rng);
+    });
     for (std::size_t cell = 0; cell < cells; ++cell) {
       ResponseCell c;
       c.cos_theta = o.cos_thetas[cell / (a1 * a2)];
