@@ -19,6 +19,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -54,29 +55,36 @@ int run_cli(const std::vector<std::string>& args)
 }
 
 // The loaded signature's numbers in the generated header's order.
-HeaderNumbers loaded_numbers(const LoadedSignature3& s)
+void add_floats(HeaderNumbers& n, const std::vector<float>& v)
+{
+  n.floats.insert(n.floats.end(), v.begin(), v.end());
+}
+void add_responses(HeaderNumbers& n, const std::vector<float>& values)
+{
+  add_floats(n, values);
+}
+void add_responses(HeaderNumbers& n, const LoadedQuantized16& values)
+{
+  add_floats(n, {values.scale, values.offset});
+  n.ints.insert(n.ints.end(), values.q.begin(), values.q.end());
+}
+HeaderNumbers loaded_numbers(const LoadedSignature3& loaded)
 {
   HeaderNumbers n;
-  auto add = [&](const std::vector<float>& v) { n.floats.insert(n.floats.end(), v.begin(), v.end()); };
-  add({s.length, s.bounding_radius, s.mass, s.unit_inertia[0], s.unit_inertia[1], s.unit_inertia[2],
-       s.material.restitution, s.material.friction, s.material.rolling_resistance, s.restitution_threshold});
-  n.ints.push_back(static_cast<long>(s.axes.size()));
-  add(s.height_axis);
-  add(s.height_mean);
-  add(s.height_stddev);
-  for (std::size_t a = 0; a < 4; ++a) add(a < s.axes.size() ? s.axes[a] : std::vector<float>{0.0f});
-  if (s.i16) {
-    add({s.mean_scale, s.mean_offset});
-    for (auto q : s.response_mean_q) n.ints.push_back(q);
-    add({s.stddev_scale, s.stddev_offset});
-    for (auto q : s.response_stddev_q) n.ints.push_back(q);
-  } else {
-    add(s.response_mean);
-    add(s.response_stddev);
-  }
-  add(s.rest_normals);
-  add(s.rest_heights);
-  add(s.rest_frequencies);
+  std::visit(
+      [&](const auto& s) {
+        add_floats(n, {s.length, s.bounding_radius, s.mass, s.unit_inertia[0], s.unit_inertia[1], s.unit_inertia[2],
+                       s.material.restitution, s.material.friction, s.material.rolling_resistance,
+                       s.restitution_threshold});
+        n.ints.push_back(static_cast<long>(s.axis_count));
+        for (const std::vector<float>* v : {&s.height_axis, &s.height_mean, &s.height_stddev, &s.axis0, &s.axis1,
+                                            &s.axis2, &s.axis3})
+          add_floats(n, *v);
+        add_responses(n, s.response_mean);
+        add_responses(n, s.response_stddev);
+        for (const std::vector<float>* v : {&s.rest_normals, &s.rest_heights, &s.rest_frequencies}) add_floats(n, *v);
+      },
+      loaded.tables);
   return n;
 }
 
@@ -206,8 +214,8 @@ TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run
     INFO(err.str());
     REQUIRE(rc == 0);
     const LoadedSignature3 s = load_signature_json(js);
-    CHECK(s.name == "tinybox");
-    CHECK(s.i16 == (std::string(precision) == "i16"));
+    CHECK(s.name() == "tinybox");
+    CHECK(s.i16() == (std::string(precision) == "i16"));
     const HeaderNumbers header = header_numbers(read_file(hpp));
     const HeaderNumbers loaded = loaded_numbers(s);
     REQUIRE(header.floats.size() == loaded.floats.size());
@@ -218,17 +226,26 @@ TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run
     CHECK(header.ints == loaded.ints);
     // Equal by construction with the committed table: the same mesh, mass and material.
     const statsim::SignatureView<3> box = statsim::tables::box.view();
-    CHECK(s.length == box.length);
-    CHECK(s.bounding_radius == box.bounding_radius);
-    CHECK(s.mass == box.mass);
-    CHECK(s.unit_inertia == box.unit_inertia);
-    CHECK(s.material.restitution == box.material.restitution);
-    CHECK(s.material.friction == box.material.friction);
-    CHECK(s.restitution_threshold == box.restitution_threshold);
+    const statsim::SignatureView<3> v = s.view();
+    CHECK(v.length == box.length);
+    CHECK(v.bounding_radius == box.bounding_radius);
+    CHECK(v.mass == box.mass);
+    CHECK(v.unit_inertia == box.unit_inertia);
+    CHECK(v.material.restitution == box.material.restitution);
+    CHECK(v.material.friction == box.material.friction);
+    CHECK(v.restitution_threshold == box.restitution_threshold);
     // Bytes as stored: the i16 response tables take half.
     const std::size_t cells = 2 * 2 * 2, values = cells * 6;
-    const std::size_t fixed = 10 * 4 + 8 + 3 * 3 * 4 + (2 + 2 + 2 + 1) * 4 + s.rest_heights.size() * 5 * 4;
-    CHECK(s.bytes() == fixed + (s.i16 ? 2 * values * 2 + 16 : 2 * values * 4));
+    const std::size_t fixed = 10 * 4 + 8 + 3 * 3 * 4 + (2 + 2 + 2 + 1) * 4 + v.rest.count * 5 * 4;
+    CHECK(s.bytes() == fixed + (s.i16() ? 2 * values * 2 + 16 : 2 * values * 4));
+    if (s.i16()) {
+      // A scale that is not the 16-bit rule's for the values would load other integers than the
+      // header holds: refused.
+      nlohmann::json j = nlohmann::json::parse(read_file(js));
+      j["response"]["i16"]["std_scale"] = 2 * j["response"]["i16"]["std_scale"].get<double>();
+      CHECK_THROWS_WITH_AS(parse_signature_json(j.dump(), "x.json"),
+                           doctest::Contains("x.json: the i16 scale and offset of the std table"), std::runtime_error);
+    }
   }
 }
 
@@ -292,9 +309,9 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
     CHECK(full.at("sample").at(k) == j.at("reference").at(k));
   // The sphere rests on its collision radius, not on a face: its rest height differs.
   CHECK(j.at("methods").at("sphere").at("rest_height_err").get<double>() > 0.0);
-  CHECK(read(chart_path).compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) == 0);
+  CHECK(read_file(chart_path).compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) == 0);
   CHECK(fs::file_size(chart_path) > 1000);
-  const std::string svg = read(dir.file("fid.svg"));
+  const std::string svg = read_file(dir.file("fid.svg"));
   CHECK(svg.find("summary error (1 = at the goals)") != std::string::npos);
   CHECK(svg.find("noise floor 90% interval") != std::string::npos);
   for (const char* m : {"sphere", "statistical", "full"}) CHECK(svg.find(m) != std::string::npos);
@@ -304,13 +321,13 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
   // The bytes chart has one point (statistical); --replot redraws it from the JSON alone, the
   // same bytes.
   CHECK(fs::file_size(bytes_path) > 1000);
-  CHECK(read(dir.file("bytes.svg")).find("signature table bytes") != std::string::npos);
+  CHECK(read_file(dir.file("bytes.svg")).find("signature table bytes") != std::string::npos);
   const std::string replotted = dir.file("bytes_replot.png");
   CHECK(run_cli({"--replot", json_path, "--chart-bytes", replotted}) == 0);
-  CHECK(read(replotted) == read(bytes_path));
-  CHECK(read(dir.file("bytes_replot.svg")) == read(dir.file("bytes.svg")));
+  CHECK(read_file(replotted) == read_file(bytes_path));
+  CHECK(read_file(dir.file("bytes_replot.svg")) == read_file(dir.file("bytes.svg")));
   CHECK(run_cli({"--replot", json_path, "--metric-charts", dir.file("metrics")}) == 0);
-  CHECK(read(dir.file("metrics/rest_tvd.svg")).find("rest_tvd (90% interval)") != std::string::npos);
+  CHECK(read_file(dir.file("metrics/rest_tvd.svg")).find("rest_tvd (90% interval)") != std::string::npos);
   CHECK(fs::file_size(dir.file("metrics/first_impact_ks.png")) > 1000);
   CHECK_FALSE(fs::exists(dir.file("metrics/pile_rest_tvd.png")));  // a run without piles
   // A missing JSON fails, and draws nothing.

@@ -183,7 +183,8 @@ TEST_CASE("gather2d: a tiny gather gives byte-identical headers across runs and 
 {
   const std::string command = "build/bin/statsim gather2d --shape lshape --out tables/tiny2d.hpp";
   const std::string one = gather2d_header(run_gather2d(tiny(1)), command);
-  const std::string two = gather2d_header(run_gather2d(tiny(2)), command);
+  const Gather2dResult r2 = run_gather2d(tiny(2));
+  const std::string two = gather2d_header(r2, command);
   const std::string again = gather2d_header(run_gather2d(tiny(2)), command);
   CHECK(one == two);
   CHECK(two == again);
@@ -199,6 +200,14 @@ TEST_CASE("gather2d: a tiny gather gives byte-identical headers across runs and 
   CHECK(one.find("> tiny2d = {") != std::string::npos);
   CHECK(one.find("nan") == std::string::npos);
   CHECK(one.find("inf") == std::string::npos);
+
+  // A value that is not finite (or not finite as a float) is refused, not written.
+  for (const double bad : {std::nan(""), HUGE_VAL, 1e39}) {
+    Gather2dResult r = r2;
+    r.cells[1].mean[2] = bad;
+    CHECK_THROWS_WITH_AS(gather2d_header(r, command), doctest::Contains("a table holds finite values only"),
+                         std::invalid_argument);
+  }
 }
 
 TEST_CASE("gather2d: the square rests on its 4 sides at height 0.5")
@@ -304,6 +313,21 @@ Compare2dOptions compare_options(int drops)
   o.repeat = 1;
   return o;
 }
+}  // namespace
+
+namespace {
+
+// Options of a compare2d run of `drops` drops, timed once, on the committed square table (which
+// compare2d must have compiled in).
+Compare2dOptions compare_options(int drops)
+{
+  REQUIRE(compare2d_has_table("square"));
+  Compare2dOptions o;
+  o.drops = drops;
+  o.repeat = 1;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("compare2d: a small drop runs in both simulations and gives finite distances")

@@ -1,5 +1,6 @@
 // tools/ref3d: the Bullet reference, `statsim gather` and the committed 3D tables.
 // Runs with the repository root as working directory (reads tools/meshes/*, tables/*).
+#include "common/table_writer.hpp"
 #include "ref3d/gather.hpp"
 #include "ref3d/model.hpp"
 #include "ref3d/ref3d.hpp"
@@ -258,6 +259,45 @@ TEST_CASE("gather3d: i16 tables dequantize within the reported error")
   }
   CHECK(seen <= worst);
   CHECK(worst <= 0.5 * std::max(mean_scale, std_scale) * 1.01 + 1e-7);
+  // The integers are statsim::quantize16 of the float tables, the rule the firmware uses.
+  std::vector<float> mean_f(mean.begin(), mean.end());
+  std::vector<std::int16_t> q(mean_f.size());
+  float scale = 0, offset = 0;
+  statsim::quantize16(mean_f.data(), mean_f.size(), scale, offset, q.data());
+  CHECK(scale == mean_scale);
+  CHECK(offset == mean_offset);
+  CHECK(std::equal(q.begin(), q.end(), h.ints.begin() + 1));
+
+  // The header compiles as a SignatureQ16 whose view reads the 16-bit responses, and its
+  // initialiser is fully braced.
+  const std::string check = dir.write("check.cpp", "#include \"tiny16.hpp\"\n"
+                                                   "static_assert(statsim::tables::box.response_mean.q.size() == 48);\n");
+  const std::string use = dir.write("use.cpp", "#include \"tiny16.hpp\"\n"
+                                               "constexpr statsim::SignatureView<3> v = statsim::tables::box.view();\n"
+                                               "static_assert(!v.response.mean.f32 && !v.response.stddev.f32);\n"
+                                               "static_assert(v.response.mean.scale > 0 && v.rest.count >= 1);\n");
+  const std::string compile = std::string(STATSIM_TEST_CXX) + " -std=c++17 -fsyntax-only -Wall -Wextra -Wpedantic -Wshadow " +
+                              "-Wconversion -Werror -I" + STATSIM_TEST_SOURCE_DIR + " -isystem " +
+                              STATSIM_TEST_EIGEN_INCLUDE + " ";
+  CHECK(std::system((compile + "-Wmissing-braces " + check).c_str()) == 0);
+  CHECK(std::system((compile + use).c_str()) == 0);
+}
+
+TEST_CASE("gather3d: a table never holds a value that is not finite")
+{
+  CHECK(hex_float(0.75) == "0x1.8p-1f");
+  CHECK(hex_float(-0.0) == "0x0p+0f");
+  CHECK(hex_float(0.1) == "0x1.99999ap-4f");  // the float nearest 0.1
+  for (const double bad : {std::nan(""), -HUGE_VAL, 1e39})
+    CHECK_THROWS_WITH_AS(hex_float(bad, "mass"), doctest::Contains("mass is"), std::invalid_argument);
+  // The generator refuses to write such a table rather than write one the runtime rejects.
+  GatherOptions o = minimal_options();
+  o.rest_drops = 24;
+  GatherResult r = gather(o);
+  REQUIRE_NOTHROW(header_text(r, "statsim gather"));
+  r.response_std[3] = std::nan("");
+  CHECK_THROWS_WITH_AS(header_text(r, "statsim gather"), doctest::Contains("a table holds finite values only"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("gather3d: bad meshes are rejected with a message and leave no file")

@@ -654,7 +654,7 @@ Setup make_setup(const FidelityOptions& o)
   s.loaded.reserve(o.tables.size());
   for (const auto& t : o.tables) {
     s.loaded.push_back(load_signature_json(t.second));
-    s.loaded.back().name = t.first;
+    s.loaded.back().name() = t.first;
   }
   SignatureView<3> compiled{};
   bool have_compiled = false;
@@ -706,11 +706,11 @@ Setup make_setup(const FidelityOptions& o)
                                                            : ", momentum pair response, resting conditions on");
     } else if (name.rfind("statistical:", 0) == 0) {
       const std::string t = name.substr(12);
-      auto it = std::find_if(s.loaded.begin(), s.loaded.end(), [&](const LoadedSignature3& l) { return l.name == t; });
+      auto it = std::find_if(s.loaded.begin(), s.loaded.end(), [&](const LoadedSignature3& l) { return l.name() == t; });
       if (it == s.loaded.end()) throw std::invalid_argument("method " + name + ": no --table " + t + "=FILE.json");
       m.table = it->view();
       m.table_bytes = static_cast<long long>(it->bytes());
-      m.description = "statsim, " + it->path + (it->i16 ? " (i16)" : " (f32)");
+      m.description = "statsim, " + it->path + (it->i16() ? " (i16)" : " (f32)");
     } else {
       throw std::invalid_argument("unknown method '" + name +
                                   "' (full, low, hull, spheres7, sphere, statistical, statistical-norest, "
@@ -720,13 +720,13 @@ Setup make_setup(const FidelityOptions& o)
   }
   // Every loaded table is compared even when not named in --methods.
   for (const LoadedSignature3& l : s.loaded) {
-    const std::string name = "statistical:" + l.name;
+    const std::string name = "statistical:" + l.name();
     if (std::none_of(s.methods.begin(), s.methods.end(), [&](const MethodSpec& m) { return m.name == name; })) {
       MethodSpec m;
       m.name = name;
       m.table = l.view();
       m.table_bytes = static_cast<long long>(l.bytes());
-      m.description = "statsim, " + l.path + (l.i16 ? " (i16)" : " (f32)");
+      m.description = "statsim, " + l.path + (l.i16() ? " (i16)" : " (f32)");
       s.methods.push_back(m);
     }
   }

@@ -4,6 +4,7 @@
 #include "common/atomic_file.hpp"
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
+#include "common/table_writer.hpp"
 #include "ref2d/box2d_util.hpp"
 #include "ref2d/compare2d.hpp"
 
@@ -47,37 +48,10 @@ std::string g6(double x)
   return fmt("%.6g", x);
 }
 
-// A float as an exact hex-float literal: 0x1.8p-1f.
-std::string hexf(double value)
+// A table array: 6 values a line, one level deeper than the entries.
+std::string hex_array(const std::vector<double>& values)
 {
-  const float f = static_cast<float>(value) + 0.0f;  // no negative zero
-  if (!std::isfinite(f)) {
-    throw std::runtime_error("gather2d: non-finite value in a table");
-  }
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%af", static_cast<double>(f));
-  return buf;
-}
-
-std::string hex_array(const std::vector<double>& values, const std::string& indent, std::size_t per_line = 6)
-{
-  if (values.empty()) {
-    return "{}";
-  }
-  std::string s = "{{";
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (i % per_line == 0) {
-      s += "\n" + indent + "    ";
-    } else {
-      s += " ";
-    }
-    s += hexf(values[i]);
-    if (i + 1 < values.size()) {
-      s += ",";
-    }
-  }
-  s += "\n" + indent + "}}";
-  return s;
+  return hex_float_array(values, ArrayStyle{6, 8, false});
 }
 
 bool is_identifier(const std::string& s)
@@ -368,22 +342,33 @@ void cluster_rest_poses(Gather2dResult& r)
   });
 }
 
-void rest_experiment(const Context& ctx, Gather2dResult& r)
+// fn(i) for every trial i < n on the options' worker threads, in order of i, with a progress
+// line `label`.
+template <class Fn>
+auto run_trials(const char* label, std::size_t n, const Gather2dOptions& o, Fn&& fn)
 {
-  const Gather2dOptions& o = r.options;
-  const auto start = std::chrono::steady_clock::now();
-  const std::size_t n = static_cast<std::size_t>(o.rest_drops);
-  Progress progress("gather2d rest poses", n, o.progress);
-  const std::vector<RestTrial> trials = parallel_map(
+  Progress progress(label, n, o.progress);
+  auto trials = parallel_map(
       n,
       [&](std::size_t i) {
-        std::mt19937_64 rng = trial_rng(o.seed, kRestPoses, 0, i);
-        RestTrial t = simulate_rest(ctx, o, rng);
+        auto t = fn(i);
         progress.add();
         return t;
       },
       o.threads);
   progress.finish();
+  return trials;
+}
+
+void rest_experiment(const Context& ctx, Gather2dResult& r)
+{
+  const Gather2dOptions& o = r.options;
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t n = static_cast<std::size_t>(o.rest_drops);
+  const std::vector<RestTrial> trials = run_trials("gather2d rest poses", n, o, [&](std::size_t i) {
+    std::mt19937_64 rng = trial_rng(o.seed, kRestPoses, 0, i);
+    return simulate_rest(ctx, o, rng);
+  });
   r.rest_drops = static_cast<int>(n);
   r.rest_ups.clear();
   r.rest_settled.clear();
@@ -402,6 +387,19 @@ void warm_up_box2d(const Context& ctx)
   // Box2D 2.4.1 fills its contact-function table lazily on first use (b2Contact::Create): do that
   // on one thread before any worker starts.
   measure_first_contact(ctx.pieces, ctx.shape.bounding_radius + 0.1, 0.0, 1.0, 0.0, 1.0 / 60.0);
+}
+
+// A result with what every run records (the options, the shape, L and the restitution threshold),
+// and Box2D ready for worker threads.
+Gather2dResult start_result(const Gather2dOptions& options, const Context& ctx)
+{
+  Gather2dResult r;
+  r.options = options;
+  r.shape = ctx.shape;
+  r.length = ctx.length;
+  r.restitution_threshold = ctx.threshold;
+  warm_up_box2d(ctx);
+  return r;
 }
 
 }  // namespace
@@ -485,13 +483,8 @@ void validate_gather2d_options(const Gather2dOptions& o)
 Gather2dResult run_rest_poses(const Gather2dOptions& options)
 {
   validate_gather2d_options(options);
-  Gather2dResult r;
-  r.options = options;
   const Context ctx = make_context(options);
-  r.shape = ctx.shape;
-  r.length = ctx.length;
-  r.restitution_threshold = ctx.threshold;
-  warm_up_box2d(ctx);
+  Gather2dResult r = start_result(options, ctx);
   rest_experiment(ctx, r);
   return r;
 }
@@ -500,13 +493,8 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
 {
   validate_gather2d_options(options);
   const Gather2dOptions& o = options;
-  Gather2dResult r;
-  r.options = o;
   const Context ctx = make_context(o);
-  r.shape = ctx.shape;
-  r.length = ctx.length;
-  r.restitution_threshold = ctx.threshold;
-  warm_up_box2d(ctx);
+  Gather2dResult r = start_result(o, ctx);
 
   // 1. Height table.
   {
@@ -515,23 +503,16 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
     r.height_dt = step_for_spin(1.0 / 60.0, max_spin);
     const std::size_t nr = o.height_ratios.size();
     const std::size_t per = static_cast<std::size_t>(o.height_trials);
-    Progress progress("gather2d heights", nr * per, o.progress);
-    const std::vector<FirstContact> trials = parallel_map(
-        nr * per,
-        [&](std::size_t flat) {
-          const std::size_t i = flat / per, k = flat % per;
-          std::mt19937_64 rng = trial_rng(o.seed, kHeightTable, i, k);
-          const double angle = 2.0 * kPi * uniform01(rng);
-          const double sign = (rng() >> 63) != 0 ? 1.0 : -1.0;
-          const double spin = sign * o.height_ratios[i] * o.height_speed / ctx.length;
-          // Start clear of the skin and the fat-AABB margin, at a random phase of one step.
-          const double height = ctx.shape.bounding_radius + 0.1 + uniform01(rng) * o.height_speed * r.height_dt;
-          FirstContact t = measure_first_contact(ctx.pieces, height, angle, o.height_speed, spin, r.height_dt);
-          progress.add();
-          return t;
-        },
-        o.threads);
-    progress.finish();
+    const std::vector<FirstContact> trials = run_trials("gather2d heights", nr * per, o, [&](std::size_t flat) {
+      const std::size_t i = flat / per, k = flat % per;
+      std::mt19937_64 rng = trial_rng(o.seed, kHeightTable, i, k);
+      const double angle = 2.0 * kPi * uniform01(rng);
+      const double sign = (rng() >> 63) != 0 ? 1.0 : -1.0;
+      const double spin = sign * o.height_ratios[i] * o.height_speed / ctx.length;
+      // Start clear of the skin and the fat-AABB margin, at a random phase of one step.
+      const double height = ctx.shape.bounding_radius + 0.1 + uniform01(rng) * o.height_speed * r.height_dt;
+      return measure_first_contact(ctx.pieces, height, angle, o.height_speed, spin, r.height_dt);
+    });
     for (std::size_t i = 0; i < nr; ++i) {
       HeightRow row;
       row.ratio = o.height_ratios[i];
@@ -562,20 +543,13 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
     const std::size_t a0 = o.cos_thetas.size(), a1 = o.signed_spins.size(), a2 = o.speeds.size();
     const std::size_t cells = a0 * a1 * a2;
     const std::size_t per = static_cast<std::size_t>(o.trials);
-    Progress progress("gather2d responses", cells * per, o.progress);
-    const std::vector<ResponseTrial> trials = parallel_map(
-        cells * per,
-        [&](std::size_t flat) {
-          const std::size_t cell = flat / per, k = flat % per;
-          const std::size_t i = cell / (a1 * a2), j = (cell / a2) % a1, l = cell % a2;
-          std::mt19937_64 rng = trial_rng(o.seed, kResponseTable, cell, k);
-          ResponseTrial t = simulate_response(ctx, o.cos_thetas[i], o.signed_spins[j], o.speeds[l], r.response_dt,
-                                              o.response_time_limit, rng);
-          progress.add();
-          return t;
-        },
-        o.threads);
-    progress.finish();
+    const std::vector<ResponseTrial> trials = run_trials("gather2d responses", cells * per, o, [&](std::size_t flat) {
+      const std::size_t cell = flat / per, k = flat % per;
+      const std::size_t i = cell / (a1 * a2), j = (cell / a2) % a1, l = cell % a2;
+      std::mt19937_64 rng = trial_rng(o.seed, kResponseTable, cell, k);
+      return simulate_response(ctx, o.cos_thetas[i], o.signed_spins[j], o.speeds[l], r.response_dt,
+                               o.response_time_limit, rng);
+    });
     for (std::size_t cell = 0; cell < cells; ++cell) {
       ResponseCell c;
       c.cos_theta = o.cos_thetas[cell / (a1 * a2)];
@@ -639,10 +613,7 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
     const double inv = 1.0 / dt;
     return std::fabs(inv - std::round(inv)) < 1e-9 * inv ? "1/" + fmt("%.0f", inv) : g6(dt);
   };
-  std::string s;
-  s += "// generated by statsim gather2d \xE2\x80\x94 do not edit\n";
-  s += "// command: " + command + "\n";
-  s += "// (run from the repository root; tools/regenerate-tables.sh regenerates every table and diffs it)\n";
+  std::string s = table_banner("gather2d", command);
   s += "// seed " + std::to_string(o.seed) + "; reference: Box2D " + std::to_string(b2_version.major) + "." +
        std::to_string(b2_version.minor) + " (Debian libbox2d 2.4.1: polygon skin b2_polygonRadius = " +
        g6(static_cast<double>(b2_polygonRadius)) + " m, b2_linearSlop = " + g6(static_cast<double>(b2_linearSlop)) +
@@ -684,39 +655,39 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
          ", " + fmt("%.6f", c.normal.y) + ") h_rest " + fmt("%.6f", c.height) + " m, " + std::to_string(c.count) +
          " drops, frequency " + fmt("%.4f", c.frequency) + "\n";
   }
-  s += "#pragma once\n\n#include \"statsim/signature.hpp\"\n\n";
-  s += "static_assert(STATSIM_TABLE_FORMAT_VERSION == 1, \"tables/" + o.name +
-       ".hpp was generated for table format 1: regenerate it with the command above\");\n\n";
-  s += "namespace statsim::tables {\n\n";
+  s += table_prologue(o.name);
   s += "// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses>\n";
-  s += "inline constexpr Signature<2, " + std::to_string(r.heights.size()) + ", " + std::to_string(o.cos_thetas.size()) +
-       ", " + std::to_string(o.signed_spins.size()) + ", " + std::to_string(o.speeds.size()) + ", 1, " +
-       std::to_string(kept.size()) + "> " + o.name + " = {\n";
-  const std::string in = "    ";
+  s += table_definition("Signature<2, " + std::to_string(r.heights.size()) + ", " + std::to_string(o.cos_thetas.size()) +
+                            ", " + std::to_string(o.signed_spins.size()) + ", " + std::to_string(o.speeds.size()) +
+                            ", 1, " + std::to_string(kept.size()) + ">",
+                        o.name);
   statsim::Material defaults;
-  s += in + "\"" + o.name + "\",\n";
-  s += in + hexf(r.length) + ",  // length L (bounding radius), m\n";
-  s += in + hexf(sh.bounding_radius) + ",  // bounding_radius, m\n";
-  s += in + hexf(sh.area) + ",  // mass, kg\n";
-  s += in + "{{" + hexf(sh.polar_inertia / sh.area) + ", " + hexf(0.0) + ", " + hexf(0.0) +
-       "}},  // unit_inertia (polar moment / mass), m^2\n";
-  s += in + "{" + hexf(o.restitution) + ", " + hexf(o.friction) + ", " +
-       hexf(static_cast<double>(defaults.rolling_resistance)) + "},  // material: restitution, friction, rolling\n";
-  s += in + hexf(static_cast<double>(r.restitution_threshold)) + ",  // restitution_threshold, m/s\n";
-  s += in + "ResponseLayout::with_speed,\n";
-  s += in + "3,  // axis_count\n";
+  const auto array = [&s](const std::string& comment, const std::vector<double>& values) {
+    s += table_comment(comment) + table_entry(hex_array(values));
+  };
+  s += table_entry("\"" + o.name + "\"");
+  s += table_entry(hex_float(r.length), "length L (bounding radius), m");
+  s += table_entry(hex_float(sh.bounding_radius), "bounding_radius, m");
+  s += table_entry(hex_float(sh.area), "mass, kg");
+  s += table_entry("{{" + hex_floats({sh.polar_inertia / sh.area, 0.0, 0.0}) + "}}",
+                   "unit_inertia (polar moment / mass), m^2");
+  s += table_entry("{" + hex_floats({o.restitution, o.friction, static_cast<double>(defaults.rolling_resistance)}) + "}",
+                   "material: restitution, friction, rolling");
+  s += table_entry(hex_float(static_cast<double>(r.restitution_threshold)), "restitution_threshold, m/s");
+  s += table_entry("ResponseLayout::with_speed");
+  s += table_entry("3", "axis_count");
   std::vector<double> hm, hsd;
   for (const HeightRow& h : r.heights) {
     hm.push_back(h.mean);
     hsd.push_back(h.std);
   }
-  s += in + "// height_axis: spin ratio |w| L / |v|\n" + in + hex_array(o.height_ratios, in) + ",\n";
-  s += in + "// height_mean, m\n" + in + hex_array(hm, in) + ",\n";
-  s += in + "// height_stddev, m\n" + in + hex_array(hsd, in) + ",\n";
-  s += in + "// axis0: cos(theta)\n" + in + hex_array(o.cos_thetas, in) + ",\n";
-  s += in + "// axis1: signed spin ratio\n" + in + hex_array(o.signed_spins, in) + ",\n";
-  s += in + "// axis2: speed |V-|, m/s\n" + in + hex_array(o.speeds, in) + ",\n";
-  s += in + "// axis3: unused\n" + in + hex_array({0.0}, in) + ",\n";
+  array("height_axis: spin ratio |w| L / |v|", o.height_ratios);
+  array("height_mean, m", hm);
+  array("height_stddev, m", hsd);
+  array("axis0: cos(theta)", o.cos_thetas);
+  array("axis1: signed spin ratio", o.signed_spins);
+  array("axis2: speed |V-|, m/s", o.speeds);
+  array("axis3: unused", {0.0});
   std::vector<double> rm, rs;
   for (const ResponseCell& c : r.cells) {
     for (int k = 0; k < 3; ++k) {
@@ -724,9 +695,8 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
       rs.push_back(c.std[static_cast<std::size_t>(k)]);
     }
   }
-  s += in + "// response_mean: per cell (cos theta slowest, then spin, then speed) w+ L/|V-|, dv_x/|V-|, dv_y/|V-|\n";
-  s += in + hex_array(rm, in) + ",\n";
-  s += in + "// response_stddev\n" + in + hex_array(rs, in) + ",\n";
+  array("response_mean: per cell (cos theta slowest, then spin, then speed) w+ L/|V-|, dv_x/|V-|, dv_y/|V-|", rm);
+  array("response_stddev", rs);
   std::vector<double> rn, rh, rf;
   for (const RestCluster& c : kept) {
     rn.push_back(c.normal.x);
@@ -734,11 +704,10 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
     rh.push_back(c.height);
     rf.push_back(c.frequency);
   }
-  s += in + "// rest_normals: body-frame up vectors\n" + in + hex_array(rn, in) + ",\n";
-  s += in + "// rest_heights, m\n" + in + hex_array(rh, in) + ",\n";
-  s += in + "// rest_frequencies\n" + in + hex_array(rf, in) + ",\n";
-  s += "};\n\n}  // namespace statsim::tables\n";
-  return s;
+  array("rest_normals: body-frame up vectors", rn);
+  array("rest_heights, m", rh);
+  array("rest_frequencies", rf);
+  return s + table_epilogue();
 }
 
 std::string gather2d_json(const Gather2dResult& r, const std::string& command)

@@ -13,6 +13,7 @@
 //     body-frame up vectors are clustered; poses seen in more than 5% of the drops are kept.
 #pragma once
 
+#include "ref2d/fig3.hpp"
 #include "ref2d/polygon2d.hpp"
 
 #include <array>
@@ -64,16 +65,8 @@ struct Gather2dOptions {
   bool progress = false;
 };
 
-struct HeightRow {
-  double ratio = 0.0;
-  double mean = 0.0;
-  double std = 0.0;
-  double min = 0.0;
-  double max = 0.0;
-  int trials = 0;
-  int late = 0;
-  int missed = 0;
-};
+/// The heights of one spin ratio, summarised as `statsim fig3` does.
+using HeightRow = Fig3Row;
 
 struct ResponseCell {
   double cos_theta = 0.0;

@@ -1,7 +1,9 @@
 #include "ref3d/gather.hpp"
 
+#include "common/format.hpp"
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
+#include "common/table_writer.hpp"
 #include "ref3d/sampling.hpp"
 #include "statsim/response.hpp"
 #include "statsim/signature.hpp"
@@ -31,28 +33,6 @@ constexpr std::uint64_t kRestStream = 3;
 constexpr std::uint64_t kCheckStream = 5;
 // Rest normals within this angle of a hull face's are snapped to it.
 constexpr double kSnapDegrees = 3.0;
-
-std::string fmt(const char* f, double x)
-{
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, x);
-  return buf;
-}
-
-// Shortest decimal that reads back to the same double (for comments and recorded options).
-std::string num(double x)
-{
-  char buf[64];
-  if (x == std::floor(x) && std::fabs(x) < 1e15) {
-    std::snprintf(buf, sizeof buf, "%.0f", x + 0.0);
-    return buf;
-  }
-  for (int p = 1; p <= 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*g", p, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
 
 // A pool of Reference objects, one per worker at most: a task borrows one and gives it back.
 // Trials build a fresh Bullet world each, so which object runs a trial does not matter.
@@ -301,6 +281,26 @@ DropTrial drop_trial(const Reference& ref, const GatherOptions& o, std::uint64_t
   return d;
 }
 
+// The index of the centre nearest to `dir` within the angle whose cosine is `cos_tol` (the first
+// of equals), or of a new centre at `dir` when none is that near.
+int nearest_or_new(std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& dir, double cos_tol)
+{
+  int best = -1;
+  double best_c = cos_tol;
+  for (std::size_t c = 0; c < centres.size(); ++c) {
+    const double d = centres[c].dot(dir);
+    if (d >= best_c) {
+      best_c = d;
+      best = static_cast<int>(c);
+    }
+  }
+  if (best < 0) {
+    best = static_cast<int>(centres.size());
+    centres.push_back(dir);
+  }
+  return best;
+}
+
 // Clusters unit vectors: leader clustering in input order within `tol` (radians), then up to 20
 // rounds of assigning each vector to the nearest cluster mean (a new cluster when none is within
 // `tol`) until nothing moves. Returns the cluster of each vector; deterministic.
@@ -309,22 +309,7 @@ std::vector<int> cluster_directions(const std::vector<Eigen::Vector3d>& dirs, do
   const double cos_tol = std::cos(tol);
   std::vector<Eigen::Vector3d> centres;
   std::vector<int> label(dirs.size(), -1);
-  for (std::size_t i = 0; i < dirs.size(); ++i) {
-    int best = -1;
-    double best_c = cos_tol;
-    for (std::size_t c = 0; c < centres.size(); ++c) {
-      const double d = centres[c].dot(dirs[i]);
-      if (d >= best_c) {
-        best_c = d;
-        best = static_cast<int>(c);
-      }
-    }
-    if (best < 0) {
-      best = static_cast<int>(centres.size());
-      centres.push_back(dirs[i]);
-    }
-    label[i] = best;
-  }
+  for (std::size_t i = 0; i < dirs.size(); ++i) label[i] = nearest_or_new(centres, dirs[i], cos_tol);
   for (int round = 0; round < 20; ++round) {
     std::vector<Eigen::Vector3d> sum(centres.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < dirs.size(); ++i) sum[label[i]] += dirs[i];
@@ -334,20 +319,7 @@ std::vector<int> cluster_directions(const std::vector<Eigen::Vector3d>& dirs, do
     bool moved = mean.size() != centres.size();
     std::vector<int> next(dirs.size(), -1);
     for (std::size_t i = 0; i < dirs.size(); ++i) {
-      int best = -1;
-      double best_c = cos_tol;
-      for (std::size_t c = 0; c < mean.size(); ++c) {
-        const double d = mean[c].dot(dirs[i]);
-        if (d >= best_c) {
-          best_c = d;
-          best = static_cast<int>(c);
-        }
-      }
-      if (best < 0) {
-        best = static_cast<int>(mean.size());
-        mean.push_back(dirs[i]);
-      }
-      next[i] = best;
+      next[i] = nearest_or_new(mean, dirs[i], cos_tol);
       moved = moved || next[i] != label[i];
     }
     label = next;
@@ -545,35 +517,17 @@ GatherResult gather(const GatherOptions& options)
 Quantized quantize(const std::vector<float>& values)
 {
   Quantized out;
-  if (values.empty()) return out;
-  float lo = values[0], hi = values[0];
-  for (float v : values) {
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
-  out.offset = 0.5f * (lo + hi);
-  out.scale = hi > lo ? (hi - lo) / 65534.0f : 1.0f;
-  out.q.reserve(values.size());
-  for (float v : values) {
-    const double qd = std::nearbyint((static_cast<double>(v) - out.offset) / out.scale);
-    const auto q = static_cast<std::int16_t>(std::clamp(qd, -32767.0, 32767.0));
-    out.q.push_back(q);
+  out.q.resize(values.size());
+  statsim::quantize16(values.data(), values.size(), out.scale, out.offset, out.q.data());
+  for (std::size_t i = 0; i < values.size(); ++i) {
     // As the runtime dequantises: offset + scale * Scalar(q), in float.
-    const float back = out.offset + out.scale * static_cast<float>(q);
-    out.worst_error = std::max(out.worst_error, std::fabs(static_cast<double>(back) - static_cast<double>(v)));
+    const float back = out.offset + out.scale * static_cast<float>(out.q[i]);
+    out.worst_error = std::max(out.worst_error, std::fabs(static_cast<double>(back) - static_cast<double>(values[i])));
   }
   return out;
 }
 
 namespace {
-
-std::string hexf(float x)
-{
-  if (x == 0.0f) return "0x0p+0f";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%af", static_cast<double>(x));
-  return buf;
-}
 
 std::vector<float> to_float(const std::vector<double>& v)
 {
@@ -581,33 +535,6 @@ std::vector<float> to_float(const std::vector<double>& v)
   f.reserve(v.size());
   for (double x : v) f.push_back(static_cast<float>(x) + 0.0f);
   return f;
-}
-
-// "{{a, b, c}}" with `per_line` values per line, indented.
-std::string float_array(const std::vector<float>& v, std::size_t per_line)
-{
-  if (v.empty()) return "{}";
-  std::string s = "{{";
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (v.size() > per_line && i % per_line == 0) s += "\n      ";
-    s += hexf(v[i]);
-    if (i + 1 < v.size()) s += (v.size() > per_line && (i + 1) % per_line == 0) ? "," : ", ";
-  }
-  s += v.size() > per_line ? "\n    }}" : "}}";
-  return s;
-}
-
-std::string int_array(const std::vector<std::int16_t>& v, std::size_t per_line)
-{
-  if (v.empty()) return "{}";
-  std::string s = "{{";
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (i % per_line == 0) s += "\n      ";
-    s += std::to_string(v[i]);
-    if (i + 1 < v.size()) s += (i + 1) % per_line == 0 ? "," : ", ";
-  }
-  s += "\n    }}";
-  return s;
 }
 
 std::string hex64(std::uint64_t x)
@@ -679,9 +606,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
   const GatherOptions& o = r.options;
   const ShapeModel& m = r.model;
   std::ostringstream h;
-  h << "// generated by statsim gather \u2014 do not edit\n";
-  h << "// command: " << command << "\n";
-  h << "// (run from the repository root; tools/regenerate-tables.sh regenerates every table and diffs it)\n";
+  h << table_banner("gather", command);
   for (const std::string& line : option_lines(r)) h << "// Options: " << line << "\n";
   for (const std::string& line : r.notes) h << "// Sized: " << line << "\n";
   h << "// Input: " << m.source;
@@ -699,48 +624,51 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << "// Rest poses (body-frame up, height, frequency):";
   for (const RestPose& p : r.rest) h << " " << vec3(p.normal, "%.4f") << " " << fmt("%.5f", p.height) << " m " << fmt("%.3f", p.frequency) << ";";
   h << "\n";
+  Quantized qm, qs;
   if (o.i16) {
-    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
+    qm = quantize(to_float(r.response_mean));
+    qs = quantize(to_float(r.response_std));
     h << "// i16 dequantization error: mean table " << fmt("%.3g", qm.worst_error) << ", std table "
       << fmt("%.3g", qs.worst_error) << " (worst " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << ")\n";
   }
-  h << "#pragma once\n\n#include \"statsim/signature.hpp\"\n\n";
-  h << "static_assert(STATSIM_TABLE_FORMAT_VERSION == 1, \"tables/" << o.name
-    << ".hpp was generated for table format 1: regenerate it with the command above\");\n\n";
+  h << table_prologue(o.name);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
                     a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
-  h << "namespace statsim::tables {\n\n";
-  h << "inline constexpr " << (o.i16 ? "SignatureQ16" : "Signature") << "<3, " << r.height_mean.size() << ", "
-    << a0 << ", " << a1 << ", " << a2 << ", " << a3 << ", " << r.rest.size() << "> " << o.name << " = {\n";
-  h << "    \"" << o.name << "\",\n";
-  h << "    " << hexf(static_cast<float>(m.bounding_radius)) << ",  // length L, m\n";
-  h << "    " << hexf(static_cast<float>(m.bounding_radius)) << ",  // bounding radius, m\n";
-  h << "    " << hexf(static_cast<float>(m.mass.mass)) << ",  // mass, kg\n";
-  h << "    " << float_array(to_float({m.unit_inertia.x(), m.unit_inertia.y(), m.unit_inertia.z()}), 8)
-    << ",  // principal moments / mass, m^2\n";
-  h << "    {" << hexf(static_cast<float>(o.reference.restitution)) << ", " << hexf(static_cast<float>(o.reference.friction))
-    << ", " << hexf(static_cast<float>(o.rolling_resistance)) << "},  // material\n";
-  h << "    " << hexf(static_cast<float>(o.reference.restitution_threshold)) << ",  // restitution threshold, m/s\n";
-  h << "    statsim::ResponseLayout::" << (o.with_speed ? "with_speed" : "scaled") << ",\n";
-  h << "    " << r.axes.size() << "u,  // response axes\n";
-  h << "    // h_coll: spin ratio, mean, std (m)\n";
-  h << "    " << float_array(to_float(o.height_ratios), 8) << ",\n";
-  h << "    " << float_array(to_float(r.height_mean), 8) << ",\n";
-  h << "    " << float_array(to_float(r.height_std), 8) << ",\n";
-  h << "    // response axes: cos theta, cos phi, " << (o.with_speed ? "speed (m/s), " : "") << "spin ratio"
-    << (o.with_speed ? "" : ", (unused)") << "\n";
-  for (std::size_t a = 0; a < 4; ++a)
-    h << "    " << (a < r.axes.size() ? float_array(to_float(r.axes[a]), 8) : std::string("{{0x0p+0f}}")) << ",\n";
-  h << "    // response mean, then std, per cell: w_x, w_y, w_z (W+ L/|V-|), dv_x, dv_y, dv_z ((V+ - V_particle+)/|V-|)\n";
+  h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
+                            std::to_string(r.height_mean.size()) + ", " + std::to_string(a0) + ", " +
+                            std::to_string(a1) + ", " + std::to_string(a2) + ", " + std::to_string(a3) + ", " +
+                            std::to_string(r.rest.size()) + ">",
+                        o.name);
+  // Short arrays on one line, long ones 8 values a line (response tables 6, one cell; normals 3).
+  const auto array = [](const std::vector<double>& v, std::size_t per_line = 8) {
+    return hex_float_array(v, ArrayStyle{per_line, 6, true});
+  };
+  h << table_entry("\"" + o.name + "\"");
+  h << table_entry(hex_float(m.bounding_radius), "length L, m");
+  h << table_entry(hex_float(m.bounding_radius), "bounding radius, m");
+  h << table_entry(hex_float(m.mass.mass), "mass, kg");
+  h << table_entry(array({m.unit_inertia.x(), m.unit_inertia.y(), m.unit_inertia.z()}), "principal moments / mass, m^2");
+  h << table_entry("{" + hex_floats({o.reference.restitution, o.reference.friction, o.rolling_resistance}) + "}",
+                   "material");
+  h << table_entry(hex_float(o.reference.restitution_threshold), "restitution threshold, m/s");
+  h << table_entry(std::string("statsim::ResponseLayout::") + (o.with_speed ? "with_speed" : "scaled"));
+  h << table_entry(std::to_string(r.axes.size()) + "u", "response axes");
+  h << table_comment("h_coll: spin ratio, mean, std (m)");
+  h << table_entry(array(o.height_ratios));
+  h << table_entry(array(r.height_mean));
+  h << table_entry(array(r.height_std));
+  h << table_comment(std::string("response axes: cos theta, cos phi, ") + (o.with_speed ? "speed (m/s), " : "") +
+                     "spin ratio" + (o.with_speed ? "" : ", (unused)"));
+  for (std::size_t a = 0; a < 4; ++a) h << table_entry(array(a < r.axes.size() ? r.axes[a] : std::vector<double>{0.0}));
+  h << table_comment("response mean, then std, per cell: w_x, w_y, w_z (W+ L/|V-|), dv_x, dv_y, dv_z ((V+ - V_particle+)/|V-|)");
   if (o.i16) {
-    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
-    h << "    " << hexf(qm.scale) << ", " << hexf(qm.offset) << ",  // mean scale, offset\n";
-    h << "    " << int_array(qm.q, 6) << ",\n";
-    h << "    " << hexf(qs.scale) << ", " << hexf(qs.offset) << ",  // std scale, offset\n";
-    h << "    " << int_array(qs.q, 6) << ",\n";
+    // statsim::Quantized16: {scale, offset, {{values}}}.
+    for (const Quantized* q : {&qm, &qs})
+      h << table_entry("{" + hex_floats({q->scale, q->offset}) + ", " + int_array(q->q, ArrayStyle{6, 6, false}) + "}",
+                       q == &qm ? "mean: scale, offset, values" : "std: scale, offset, values");
   } else {
-    h << "    " << float_array(to_float(r.response_mean), 6) << ",\n";
-    h << "    " << float_array(to_float(r.response_std), 6) << ",\n";
+    h << table_entry(array(r.response_mean, 6));
+    h << table_entry(array(r.response_std, 6));
   }
   std::vector<double> normals, heights, freqs;
   for (const RestPose& p : r.rest) {
@@ -748,11 +676,11 @@ std::string header_text(const GatherResult& r, const std::string& command)
     heights.push_back(p.height);
     freqs.push_back(p.frequency);
   }
-  h << "    // rest poses: body-frame up vectors, centre heights (m), frequencies\n";
-  h << "    " << float_array(to_float(normals), 3) << ",\n";
-  h << "    " << float_array(to_float(heights), 8) << ",\n";
-  h << "    " << float_array(to_float(freqs), 8) << ",\n";
-  h << "};\n\n}  // namespace statsim::tables\n";
+  h << table_comment("rest poses: body-frame up vectors, centre heights (m), frequencies");
+  h << table_entry(array(normals, 3));
+  h << table_entry(array(heights));
+  h << table_entry(array(freqs));
+  h << table_epilogue();
   return h.str();
 }
 

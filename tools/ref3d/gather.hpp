@@ -132,7 +132,8 @@ ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, doubl
 /// One h_coll flight: the centre height at first contact.
 double height_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index);
 
-/// The float (Scalar) values written to the header, and their 16-bit quantisation.
+/// The 16-bit form of the float (Scalar) values written to a header, by statsim::quantize16 (the
+/// one rule), and the largest error of reading them back.
 struct Quantized {
   float scale = 1.0f, offset = 0.0f;
   std::vector<std::int16_t> q;

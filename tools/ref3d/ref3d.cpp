@@ -243,18 +243,14 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   sub->add_option("--name", o.name, "Table name (default: the shape's name)");
   sub->add_option("--speed", o.speed, "|V-| of the impacts of the scaled layout, m/s")->capture_default_str();
   sub->add_option("--speeds", o.speeds, "Speed axis of --layout paper, m/s (comma-separated)")->delimiter(',');
-  sub->add_option("--cos-theta", o.cos_theta, "Response axis: cos theta samples, increasing, in (0, 1]")
-      ->delimiter(',')
-      ->capture_default_str();
-  sub->add_option("--cos-phi", o.cos_phi, "Response axis: cos phi samples, increasing, in [-1, 1]")
-      ->delimiter(',')
-      ->capture_default_str();
-  sub->add_option("--spin-ratios", o.spin_ratios, "Response axis: spin ratios |W-| L / |V-|, increasing, >= 0")
-      ->delimiter(',')
-      ->capture_default_str();
-  sub->add_option("--height-ratios", o.height_ratios, "h_coll axis: spin ratios, increasing, >= 0")
-      ->delimiter(',')
-      ->capture_default_str();
+  // A table axis: comma-separated samples, the default shown in --help.
+  const auto axis_option = [sub](const char* flag, std::vector<double>& axis, const char* help) {
+    sub->add_option(flag, axis, help)->delimiter(',')->capture_default_str();
+  };
+  axis_option("--cos-theta", o.cos_theta, "Response axis: cos theta samples, increasing, in (0, 1]");
+  axis_option("--cos-phi", o.cos_phi, "Response axis: cos phi samples, increasing, in [-1, 1]");
+  axis_option("--spin-ratios", o.spin_ratios, "Response axis: spin ratios |W-| L / |V-|, increasing, >= 0");
+  axis_option("--height-ratios", o.height_ratios, "h_coll axis: spin ratios, increasing, >= 0");
   sub->add_option("--restitution", s.restitution, "Coefficient of restitution (reference and V_particle+)")
       ->capture_default_str();
   sub->add_option("--friction", s.friction, "Coulomb friction coefficient (reference and V_particle+)")

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace statsim::tools {
 namespace {
@@ -52,55 +53,114 @@ void expect_size(const std::vector<Scalar>& v, std::size_t n, const std::string&
     fail(origin, "field '" + name + "' has " + std::to_string(v.size()) + " values, expected " + std::to_string(n));
 }
 
-// The generator's quantisation rule (tools/ref3d/gather.cpp quantize()), applied to the float
-// values with the scale and offset the JSON states.
-std::vector<std::int16_t> requantize(const std::vector<Scalar>& values, Scalar scale, Scalar offset)
+// Response tables as floats.
+void set_responses(BasicLoadedSignature3<std::vector<Scalar>>& s, std::vector<Scalar> mean, std::vector<Scalar> stddev,
+                   const json&, const std::string&)
 {
-  std::vector<std::int16_t> q;
-  q.reserve(values.size());
-  for (Scalar v : values) {
-    const double qd = std::nearbyint((static_cast<double>(v) - static_cast<double>(offset)) / static_cast<double>(scale));
-    q.push_back(static_cast<std::int16_t>(std::clamp(qd, -32767.0, 32767.0)));
+  s.response_mean = std::move(mean);
+  s.response_stddev = std::move(stddev);
+}
+
+// Response tables as 16-bit integers, by the generator's rule (statsim::quantize16), which must
+// give the scales and offsets that `i16` states.
+void set_responses(BasicLoadedSignature3<LoadedQuantized16>& s, std::vector<Scalar> mean, std::vector<Scalar> stddev,
+                   const json& i16, const std::string& origin)
+{
+  const Scalar mean_scale = number(i16, "mean_scale", origin, "response.i16.");
+  const Scalar mean_offset = number(i16, "mean_offset", origin, "response.i16.");
+  const Scalar std_scale = number(i16, "std_scale", origin, "response.i16.");
+  const Scalar std_offset = number(i16, "std_offset", origin, "response.i16.");
+  if (!(mean_scale > 0) || !(std_scale > 0)) fail(origin, "i16 scales must be positive");
+  const auto quantized = [&](const std::vector<Scalar>& values, Scalar scale, Scalar offset, const char* table) {
+    LoadedQuantized16 q;
+    q.q.resize(values.size());
+    quantize16(values.data(), values.size(), q.scale, q.offset, q.q.data());
+    if (q.scale != scale || q.offset != offset)
+      fail(origin, std::string("the i16 scale and offset of the ") + table +
+                       " table are not those of the 16-bit rule (statsim::quantize16) for its values");
+    return q;
+  };
+  s.response_mean = quantized(mean, mean_scale, mean_offset, "mean");
+  s.response_stddev = quantized(stddev, std_scale, std_offset, "std");
+}
+
+// Every part of `s` from the JSON `j`, checked in the order of the format.
+template <class Responses>
+void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::string& origin)
+{
+  const json& name = field(j, "name", origin);
+  if (!name.is_string()) fail(origin, "field 'name' is not a string");
+  s.name = name.get<std::string>();
+  s.length = number(j, "length", origin);
+  s.bounding_radius = number(j, "bounding_radius", origin);
+  s.mass = number(j, "mass", origin);
+  const std::vector<Scalar> ui = numbers(j, "unit_inertia", origin);
+  expect_size(ui, 3, "unit_inertia", origin);
+  std::copy(ui.begin(), ui.end(), s.unit_inertia.begin());
+  const json& mat = field(j, "material", origin);
+  s.material.restitution = number(mat, "restitution", origin, "material.");
+  s.material.friction = number(mat, "friction", origin, "material.");
+  s.material.rolling_resistance = number(mat, "rolling_resistance", origin, "material.");
+  s.restitution_threshold = number(j, "restitution_threshold", origin);
+
+  const json& h = field(j, "h_coll", origin);
+  s.height_axis = numbers(h, "ratio", origin, "h_coll.");
+  s.height_mean = numbers(h, "mean", origin, "h_coll.");
+  s.height_stddev = numbers(h, "std", origin, "h_coll.");
+  if (s.height_axis.empty()) fail(origin, "field 'h_coll.ratio' is empty");
+  expect_size(s.height_mean, s.height_axis.size(), "h_coll.mean", origin);
+  expect_size(s.height_stddev, s.height_axis.size(), "h_coll.std", origin);
+
+  const json& r = field(j, "response", origin);
+  const json& layout = field(r, "layout", origin, "response.");
+  if (layout == "scaled") s.layout = ResponseLayout::scaled;
+  else if (layout == "with_speed") s.layout = ResponseLayout::with_speed;
+  else fail(origin, "field 'response.layout' is neither \"scaled\" nor \"with_speed\"");
+  const json& axes = field(r, "axes", origin, "response.");
+  const std::size_t want_axes = s.layout == ResponseLayout::scaled ? 3 : 4;
+  if (!axes.is_array() || axes.size() != want_axes)
+    fail(origin, "field 'response.axes' must hold " + std::to_string(want_axes) + " axes for this layout");
+  s.axis_count = static_cast<std::uint32_t>(want_axes);
+  std::vector<Scalar>* const parts[] = {&s.axis0, &s.axis1, &s.axis2, &s.axis3};
+  std::size_t cells = 1;
+  for (std::size_t a = 0; a < want_axes; ++a) {
+    *parts[a] = numbers(axes[a], "values", origin, "response.axes[].");
+    if (parts[a]->empty()) fail(origin, "a response axis is empty");
+    cells *= parts[a]->size();
   }
-  return q;
+  if (want_axes == 3) s.axis3 = {0};
+  std::vector<Scalar> mean = numbers(r, "mean", origin, "response.");
+  std::vector<Scalar> stddev = numbers(r, "std", origin, "response.");
+  expect_size(mean, cells * 6, "response.mean", origin);
+  expect_size(stddev, cells * 6, "response.std", origin);
+  set_responses(s, std::move(mean), std::move(stddev), r.contains("i16") ? r.at("i16") : json(), origin);
+
+  const json& rest = field(j, "rest", origin);
+  if (!rest.is_array()) fail(origin, "field 'rest' is not an array");
+  for (const json& p : rest) {
+    const std::vector<Scalar> n = numbers(p, "normal", origin, "rest[].");
+    expect_size(n, 3, "rest[].normal", origin);
+    s.rest_normals.insert(s.rest_normals.end(), n.begin(), n.end());
+    s.rest_heights.push_back(number(p, "height", origin, "rest[]."));
+    s.rest_frequencies.push_back(number(p, "frequency", origin, "rest[]."));
+  }
 }
 
 }  // namespace
 
+std::string& LoadedSignature3::name()
+{
+  return std::visit([](auto& t) -> std::string& { return t.name; }, tables);
+}
+
+const std::string& LoadedSignature3::name() const
+{
+  return std::visit([](const auto& t) -> const std::string& { return t.name; }, tables);
+}
+
 SignatureView<3> LoadedSignature3::view() const
 {
-  SignatureView<3> v;
-  v.name = name.c_str();
-  v.length = length;
-  v.bounding_radius = bounding_radius;
-  v.mass = mass;
-  v.unit_inertia = unit_inertia;
-  v.material = material;
-  v.restitution_threshold = restitution_threshold;
-  v.layout = layout;
-  v.height.spin_ratio = AxisView{height_axis.data(), static_cast<std::uint32_t>(height_axis.size())};
-  v.height.mean.f32 = height_mean.data();
-  v.height.stddev.f32 = height_stddev.data();
-  for (std::size_t a = 0; a < max_response_axes; ++a) {
-    // Unused axes of a 3-axis table are one sample, as in the generated headers (A3 = 1).
-    static const Scalar zero = 0;
-    v.response.axes[a] = a < axes.size() ? AxisView{axes[a].data(), static_cast<std::uint32_t>(axes[a].size())}
-                                         : AxisView{&zero, 1};
-  }
-  v.response.axis_count = static_cast<std::uint32_t>(axes.size());
-  v.response.components = 6;
-  if (i16) {
-    v.response.mean = ValuesView{nullptr, response_mean_q.data(), mean_scale, mean_offset};
-    v.response.stddev = ValuesView{nullptr, response_stddev_q.data(), stddev_scale, stddev_offset};
-  } else {
-    v.response.mean.f32 = response_mean.data();
-    v.response.stddev.f32 = response_stddev.data();
-  }
-  v.rest.normals = rest_normals.data();
-  v.rest.heights = rest_heights.data();
-  v.rest.frequencies = rest_frequencies.data();
-  v.rest.count = static_cast<std::uint32_t>(rest_heights.size());
-  return v;
+  return std::visit([](const auto& t) { return t.view(); }, tables);
 }
 
 std::size_t LoadedSignature3::bytes() const
@@ -138,73 +198,10 @@ LoadedSignature3 parse_signature_json(const std::string& text, const std::string
   if (!j.is_object()) fail(origin, "not a JSON object");
   LoadedSignature3 s;
   s.path = origin;
+  const json* response = j.contains("response") ? &j.at("response") : nullptr;
+  if (response && response->is_object() && response->contains("i16")) s.tables.emplace<1>();
   try {
-    const json& name = field(j, "name", origin);
-    if (!name.is_string()) fail(origin, "field 'name' is not a string");
-    s.name = name.get<std::string>();
-    s.length = number(j, "length", origin);
-    s.bounding_radius = number(j, "bounding_radius", origin);
-    s.mass = number(j, "mass", origin);
-    const std::vector<Scalar> ui = numbers(j, "unit_inertia", origin);
-    expect_size(ui, 3, "unit_inertia", origin);
-    std::copy(ui.begin(), ui.end(), s.unit_inertia.begin());
-    const json& mat = field(j, "material", origin);
-    s.material.restitution = number(mat, "restitution", origin, "material.");
-    s.material.friction = number(mat, "friction", origin, "material.");
-    s.material.rolling_resistance = number(mat, "rolling_resistance", origin, "material.");
-    s.restitution_threshold = number(j, "restitution_threshold", origin);
-
-    const json& h = field(j, "h_coll", origin);
-    s.height_axis = numbers(h, "ratio", origin, "h_coll.");
-    s.height_mean = numbers(h, "mean", origin, "h_coll.");
-    s.height_stddev = numbers(h, "std", origin, "h_coll.");
-    if (s.height_axis.empty()) fail(origin, "field 'h_coll.ratio' is empty");
-    expect_size(s.height_mean, s.height_axis.size(), "h_coll.mean", origin);
-    expect_size(s.height_stddev, s.height_axis.size(), "h_coll.std", origin);
-
-    const json& r = field(j, "response", origin);
-    const json& layout = field(r, "layout", origin, "response.");
-    if (layout == "scaled") s.layout = ResponseLayout::scaled;
-    else if (layout == "with_speed") s.layout = ResponseLayout::with_speed;
-    else fail(origin, "field 'response.layout' is neither \"scaled\" nor \"with_speed\"");
-    const json& axes = field(r, "axes", origin, "response.");
-    const std::size_t want_axes = s.layout == ResponseLayout::scaled ? 3 : 4;
-    if (!axes.is_array() || axes.size() != want_axes)
-      fail(origin, "field 'response.axes' must hold " + std::to_string(want_axes) + " axes for this layout");
-    std::size_t cells = 1;
-    for (const json& a : axes) {
-      s.axes.push_back(numbers(a, "values", origin, "response.axes[]."));
-      if (s.axes.back().empty()) fail(origin, "a response axis is empty");
-      cells *= s.axes.back().size();
-    }
-    std::vector<Scalar> mean = numbers(r, "mean", origin, "response.");
-    std::vector<Scalar> stddev = numbers(r, "std", origin, "response.");
-    expect_size(mean, cells * 6, "response.mean", origin);
-    expect_size(stddev, cells * 6, "response.std", origin);
-    if (r.contains("i16")) {
-      const json& q = r.at("i16");
-      s.i16 = true;
-      s.mean_scale = number(q, "mean_scale", origin, "response.i16.");
-      s.mean_offset = number(q, "mean_offset", origin, "response.i16.");
-      s.stddev_scale = number(q, "std_scale", origin, "response.i16.");
-      s.stddev_offset = number(q, "std_offset", origin, "response.i16.");
-      if (!(s.mean_scale > 0) || !(s.stddev_scale > 0)) fail(origin, "i16 scales must be positive");
-      s.response_mean_q = requantize(mean, s.mean_scale, s.mean_offset);
-      s.response_stddev_q = requantize(stddev, s.stddev_scale, s.stddev_offset);
-    } else {
-      s.response_mean = std::move(mean);
-      s.response_stddev = std::move(stddev);
-    }
-
-    const json& rest = field(j, "rest", origin);
-    if (!rest.is_array()) fail(origin, "field 'rest' is not an array");
-    for (const json& p : rest) {
-      const std::vector<Scalar> n = numbers(p, "normal", origin, "rest[].");
-      expect_size(n, 3, "rest[].normal", origin);
-      s.rest_normals.insert(s.rest_normals.end(), n.begin(), n.end());
-      s.rest_heights.push_back(number(p, "height", origin, "rest[]."));
-      s.rest_frequencies.push_back(number(p, "frequency", origin, "rest[]."));
-    }
+    std::visit([&](auto& t) { parse_parts(j, t, origin); }, s.tables);
   } catch (const json::exception& e) {
     fail(origin, std::string("bad field: ") + e.what());
   }

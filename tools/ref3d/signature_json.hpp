@@ -7,9 +7,9 @@
 // friction, rolling_resistance}, restitution_threshold, h_coll {ratio, mean, std},
 // response {layout, axes [{values}], mean, std, i16 {mean_scale, mean_offset, std_scale,
 // std_offset} (optional)}, rest [{normal, height, frequency}]. When the JSON has "i16", the
-// response tables are quantised again by the generator's rule (q = nearest integer to
-// (v - offset) / scale, clamped to +-32767, v as float) and used as 16-bit integers, as the
-// generated SignatureQ16 header stores them.
+// response tables are quantised again by the generator's rule, statsim::quantize16 (which must
+// give the scales and offsets the JSON states), and used as 16-bit integers, as the generated
+// SignatureQ16 header stores them.
 #pragma once
 
 #include "statsim/signature.hpp"
@@ -17,16 +17,26 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace statsim::tools {
 
-/// A signature loaded from JSON, owning its arrays; view() points into them (the object must
-/// outlive every view and every world that uses one, and must not be moved while they live:
-/// moving a std::vector keeps its buffer, so moving the object itself is safe).
-struct LoadedSignature3 {
+/// 16-bit response values with their scale and offset, as statsim::Quantized16 holds them, in a
+/// growable array.
+struct LoadedQuantized16 {
+  Scalar scale = 1;
+  Scalar offset = 0;
+  std::vector<std::int16_t> q;
+};
+
+/// The parts of a signature loaded from JSON, named as in statsim::BasicSignature so that
+/// statsim::signature_view<3> builds their view. `Responses`: std::vector<Scalar> (f32 tables)
+/// or LoadedQuantized16 (i16 tables). Unused response axes hold one sample, as in a generated
+/// header.
+template <class Responses>
+struct BasicLoadedSignature3 {
   std::string name;
-  std::string path;  ///< the file it came from
   Scalar length = 0;
   Scalar bounding_radius = 0;
   Scalar mass = 0;
@@ -34,14 +44,27 @@ struct LoadedSignature3 {
   Material material{};
   Scalar restitution_threshold = 0;
   ResponseLayout layout = ResponseLayout::scaled;
+  std::uint32_t axis_count = 0;  ///< 3 (scaled) or 4 (with_speed)
   std::vector<Scalar> height_axis, height_mean, height_stddev;
-  std::vector<std::vector<Scalar>> axes;  ///< 3 (scaled) or 4 (with_speed)
-  std::vector<Scalar> response_mean, response_stddev;  ///< f32 storage (empty when i16)
-  bool i16 = false;
-  std::vector<std::int16_t> response_mean_q, response_stddev_q;  ///< i16 storage
-  Scalar mean_scale = 1, mean_offset = 0, stddev_scale = 1, stddev_offset = 0;
+  std::vector<Scalar> axis0, axis1, axis2, axis3;
+  Responses response_mean, response_stddev;
   std::vector<Scalar> rest_normals, rest_heights, rest_frequencies;
 
+  SignatureView<3> view() const { return signature_view<3>(*this); }
+};
+
+/// A signature loaded from JSON, owning its arrays; view() points into them (the object must
+/// outlive every view and every world that uses one, and must not be moved while they live:
+/// moving a std::vector keeps its buffer, so moving the object itself is safe).
+struct LoadedSignature3 {
+  std::string path;  ///< the file it came from
+  /// f32 tables, or i16 tables when the JSON has "response.i16".
+  std::variant<BasicLoadedSignature3<std::vector<Scalar>>, BasicLoadedSignature3<LoadedQuantized16>> tables;
+
+  bool i16() const { return tables.index() == 1; }
+  /// The table's name (from the JSON; a caller may rename it).
+  std::string& name();
+  const std::string& name() const;
   SignatureView<3> view() const;
   /// Table bytes as stored in a generated header: axes, h_coll table, response tables at the
   /// stored precision (4 or 2 bytes a value, plus the i16 scales and offsets), rest poses, and

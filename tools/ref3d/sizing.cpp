@@ -1,5 +1,6 @@
 #include "ref3d/sizing.hpp"
 
+#include "common/format.hpp"
 #include "common/parallel.hpp"
 #include "statsim/signature.hpp"
 
@@ -13,24 +14,6 @@
 namespace statsim::tools::ref3d {
 
 namespace {
-
-std::string fmt(const char* f, double x)
-{
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, x);
-  return buf;
-}
-
-// Shortest decimal that reads back to the same double.
-std::string num(double x)
-{
-  char buf[64];
-  for (int p = 1; p <= 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*g", p, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
 
 std::vector<float> as_float(const std::vector<double>& v)
 {

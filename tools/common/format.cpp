@@ -1,0 +1,31 @@
+// See format.hpp.
+#include "common/format.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace statsim::tools {
+
+std::string fmt(const char* format, double x)
+{
+  char buf[128];
+  std::snprintf(buf, sizeof buf, format, x);
+  return buf;
+}
+
+std::string num(double x)
+{
+  char buf[64];
+  if (x == std::floor(x) && std::fabs(x) < 1e15) {
+    std::snprintf(buf, sizeof buf, "%.0f", x + 0.0);
+    return buf;
+  }
+  for (int p = 1; p <= 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*g", p, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+}  // namespace statsim::tools

@@ -1,0 +1,16 @@
+// Numbers as text for the host tools' reports, comments of generated files and recorded options.
+#pragma once
+
+#include <string>
+
+namespace statsim::tools {
+
+/// `x` formatted by printf's `format`, which must hold exactly one conversion of a double
+/// ("%.6g", "%+.4f"...).
+std::string fmt(const char* format, double x);
+
+/// The shortest decimal that reads back to the same double ("0.05", "1e-07"); integers below
+/// 1e15 in full ("1000", not "1e+03"), and zero of either sign as "0".
+std::string num(double x);
+
+}  // namespace statsim::tools
