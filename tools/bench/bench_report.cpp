@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -375,18 +376,8 @@ BenchResult bench_from_csv(const std::string& text)
     return out;
   };
   std::vector<std::string> lines;
-  {
-    std::string line;
-    for (char ch : text) {
-      if (ch == '\n') {
-        lines.push_back(line);
-        line.clear();
-      } else {
-        line += ch;
-      }
-    }
-    if (!line.empty()) lines.push_back(line);
-  }
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
   if (lines.empty()) throw std::invalid_argument("bench CSV: empty");
   const std::vector<std::string> header = fields(lines[0]);
   auto column = [&](const char* name) {

@@ -1,6 +1,5 @@
-#include "export/export_commands.hpp"
-
 #include "export/gltf_export.hpp"
+
 #include "render/frames.hpp"
 #include "render/render.hpp"
 

@@ -318,6 +318,17 @@ struct ScreenBox {
   bool visible = false;
 };
 
+/// The pixels to visit for `box` in the band of rows y0 .. y1 of an image `w` pixels wide: from
+/// x0 to x1 and y0 to y1, inclusive (empty when a start is past its end).
+struct PixelSpan {
+  int x0, x1, y0, y1;
+};
+PixelSpan pixel_span(const ScreenBox& box, int y0, int y1, int w)
+{
+  return {int(std::clamp(box.x0, 0.0, double(w))), int(std::clamp(box.x1 + 1, -1.0, double(w - 1))),
+          int(std::clamp(box.y0, double(y0), double(y1))), int(std::clamp(box.y1 + 1, double(y0 - 1), double(y1 - 1)))};
+}
+
 }  // namespace
 
 Image render_frame(const Frame& frame, const std::vector<const RenderShape*>& shapes, const Camera& camera,
@@ -446,12 +457,9 @@ Image render_frame(const Frame& frame, const std::vector<const RenderShape*>& sh
           const RenderShape& s = *shapes[std::size_t(b.shape)];
           const double r = 0.8 * s.bounding_radius * body_scale(s, b);
           const double strength = 0.45 * std::max(0.0, 1.0 - std::max(0.0, b.position.z() - r) / (3 * r));
-          const int sy0 = int(std::clamp(box.y0, double(y0), double(y1)));
-          const int sy1 = int(std::clamp(box.y1 + 1, double(y0 - 1), double(y1 - 1)));
-          const int sx0 = int(std::clamp(box.x0, 0.0, double(W)));
-          const int sx1 = int(std::clamp(box.x1 + 1, -1.0, double(W - 1)));
-          for (int y = sy0; y <= sy1; ++y)
-            for (int x = sx0; x <= sx1; ++x) {
+          const PixelSpan span = pixel_span(box, y0, y1, W);
+          for (int y = span.y0; y <= span.y1; ++y)
+            for (int x = span.x0; x <= span.x1; ++x) {
               const std::size_t p = std::size_t(y) * std::size_t(W) + std::size_t(x);
               if (!(depth[p] > 0)) continue;
               Eigen::Vector3d o, d;
@@ -530,12 +538,9 @@ Image render_frame(const Frame& frame, const std::vector<const RenderShape*>& sh
           const RenderShape& s = *shapes[std::size_t(b.shape)];
           const double r = b.radius > 0 ? b.radius : s.table_sphere_radius;
           if (!(r > 0)) continue;
-          const int sy0 = int(std::clamp(box.y0, double(y0), double(y1)));
-          const int sy1 = int(std::clamp(box.y1 + 1, double(y0 - 1), double(y1 - 1)));
-          const int sx0 = int(std::clamp(box.x0, 0.0, double(W)));
-          const int sx1 = int(std::clamp(box.x1 + 1, -1.0, double(W - 1)));
-          for (int y = sy0; y <= sy1; ++y)
-            for (int x = sx0; x <= sx1; ++x) {
+          const PixelSpan span = pixel_span(box, y0, y1, W);
+          for (int y = span.y0; y <= span.y1; ++y)
+            for (int x = span.x0; x <= span.x1; ++x) {
               Eigen::Vector3d o, d;
               pj.ray(x + 0.5, y + 0.5, o, d);
               const Eigen::Vector3d oc = o - b.position;

@@ -1,9 +1,8 @@
-#include "render/render_commands.hpp"
+#include "render/render.hpp"
 
 #include "common/progress.hpp"
 #include "render/frames.hpp"
 #include "render/reference_run.hpp"
-#include "render/render.hpp"
 
 #include <CLI/CLI.hpp>
 
