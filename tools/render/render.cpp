@@ -18,6 +18,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 #ifndef STATSIM_RENDER_MESHES_DIR
 #define STATSIM_RENDER_MESHES_DIR "tools/meshes"
@@ -128,6 +129,24 @@ bool load_render_shape(const std::string& name, const std::string& meshes_dir, R
     return false;
   }
   for (const Eigen::Vector3f& v : shape.vertices) shape.bounding_radius = std::max(shape.bounding_radius, double(v.norm()));
+  return true;
+}
+
+bool load_frames(const std::string& path, const std::string& shape_names, const std::string& detail,
+                 const std::string& meshes_dir, LoadedFrames& out, std::string& error)
+{
+  std::vector<std::string> names;
+  std::stringstream list(shape_names);
+  for (std::string item; std::getline(list, item, ',');) names.push_back(item);
+  if (!read_frames(path, names, out.frames, error)) return false;
+  const int bodies = out.frames.body_count();
+  for (const std::string& name : out.frames.shapes) {
+    const bool low = name == "bunny" && (detail == "low" || (detail == "auto" && bodies > 1000));
+    auto s = std::make_unique<RenderShape>();
+    if (!load_render_shape(low ? "bunny_low" : name, meshes_dir, *s, error)) return false;
+    out.shapes.push_back(s.get());
+    out.owned.push_back(std::move(s));
+  }
   return true;
 }
 
