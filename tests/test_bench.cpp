@@ -280,8 +280,8 @@ TEST_CASE("bench 2D tiny configuration runs every method")
   o.repeats = 1;
   o.progress = false;
   const BenchResult r = run_bench(o);
-  // polygon, circle, statistical, and statsim's other broad phase when the runtime has a choice.
-  CHECK(r.cells.size() >= 3);
+  // polygon, circle, statistical (the automatic broad phase), statistical-grid, statistical-sap.
+  CHECK(r.cells.size() == 5);
   check_cells(r);
   check_csv(r);
   check_markdown(r);

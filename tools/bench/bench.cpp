@@ -149,7 +149,7 @@ const std::vector<std::string>& methods2()
   static const std::vector<std::string> m{"polygon", "circle", "statistical", "statistical-sap", "statistical-grid"};
   return m;
 }
-/// The benchmark's methods, plus statsim with its other broad phase when the runtime has a choice.
+/// The benchmark's methods, plus statsim forced to each broad phase that is not its default.
 std::vector<std::string> default_methods(int dim)
 {
   std::vector<std::string> m = dim == 2 ? std::vector<std::string>{"polygon", "circle", "statistical"}
