@@ -1,6 +1,7 @@
 // The shared drop scenes (tools/scenes) and `statsim bench` on a tiny configuration. Whole-scene
 // timing is a benchmark, not a test: nothing here asserts a time beyond "finite and positive".
 #include "bench/bench.hpp"
+#include "bullet/drop_world.hpp"
 #include "scenes/scenes.hpp"
 
 #include <doctest/doctest.h>
@@ -244,7 +245,6 @@ TEST_CASE("bench 3D tiny configuration runs every method")
   o.steps = 4;
   o.warmup = 1;
   o.repeats = 2;
-  o.allow_synthetic = true;  // the bunny table may not be generated yet
   o.progress = false;
   const BenchResult r = run_bench(o);
   CHECK(r.cells.size() == 5 * 2 + 1);
@@ -296,11 +296,10 @@ TEST_CASE("bench 2D tiny configuration runs every method")
   o.steps = 4;
   o.warmup = 1;
   o.repeats = 1;
-  o.allow_synthetic = true;
   o.progress = false;
   const BenchResult r = run_bench(o);
-  // polygon, circle, statistical, and statsim's other broad phase when the runtime has a choice.
-  CHECK(r.cells.size() >= 3);
+  // polygon, circle, statistical (the automatic broad phase), statistical-grid, statistical-sap.
+  CHECK(r.cells.size() == 5);
   check_cells(r);
   check_csv(r);
   check_markdown(r);
@@ -340,4 +339,42 @@ TEST_CASE("bench rejects bad options")
   o = BenchOptions{};
   o.dt = -1;
   CHECK_THROWS_AS(validate_bench_options(o), std::invalid_argument);
+}
+
+TEST_CASE("Bullet drop world: spheres fall onto the planes, come to rest and deactivate")
+{
+  bullet::Shapes shapes;
+  bullet::DropBody body;
+  const double r = 0.1;
+  body.shape = shapes.sphere(r);
+  body.mass = 1.0;
+  body.inertia = Eigen::Vector3d::Constant(0.4 * r * r);
+  body.bounding_radius = r;
+  std::vector<scenes::BodyState3> states(2);
+  states[0].position = Eigen::Vector3d(0, 0, 1);
+  states[1].position = Eigen::Vector3d(1, 0, 0.5);
+  bullet::DropSettings settings;
+  settings.restitution = 0.0;
+  // A second plane, tilted, far away: planes are added as given.
+  settings.planes.push_back({Eigen::Vector3d(1, 0, 1).normalized(), -10.0});
+  bullet::DropWorld world(body, states, settings);
+  REQUIRE(world.size() == 2);
+  CHECK(world.state(0).position == states[0].position);
+  world.step(1.0 / 60);
+  CHECK(world.state(0).linear_velocity.z() < 0);  // gravity pulls down
+  for (int k = 0; k < 600; ++k) world.step(1.0 / 60);
+  for (std::size_t i = 0; i < world.size(); ++i) {
+    CHECK(world.state(i).position.z() == doctest::Approx(r).epsilon(0.02));
+    CHECK(world.asleep(i));
+  }
+  CHECK(world.asleep_count() == 2);
+  CHECK(world.touching_pairs() == 2);
+  CHECK(world.deepest_penetration() < 0.01 * r);
+
+  // Without deactivation nothing sleeps; four substeps of dt / 4 reach the same rest.
+  settings.sleeping = false;
+  bullet::DropWorld awake(body, states, settings);
+  for (int k = 0; k < 300; ++k) awake.step(1.0 / 60, 4);
+  CHECK(awake.asleep_count() == 0);
+  CHECK(awake.state(0).position.z() == doctest::Approx(r).epsilon(0.02));
 }

@@ -315,21 +315,6 @@ Compare2dOptions compare_options(int drops)
 }
 }  // namespace
 
-namespace {
-
-// Options of a compare2d run of `drops` drops, timed once, on the committed square table (which
-// compare2d must have compiled in).
-Compare2dOptions compare_options(int drops)
-{
-  REQUIRE(compare2d_has_table("square"));
-  Compare2dOptions o;
-  o.drops = drops;
-  o.repeat = 1;
-  return o;
-}
-
-}  // namespace
-
 TEST_CASE("compare2d: a small drop runs in both simulations and gives finite distances")
 {
   Compare2dOptions o = compare_options(2);

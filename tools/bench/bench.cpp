@@ -81,7 +81,7 @@ std::vector<Eigen::Vector4d> load_spheres(const std::string& path, const MassPro
 
 }  // namespace
 
-Body3 load_body3(const std::string& shape, const std::string& meshes_dir, bool allow_synthetic)
+Body3 load_body3(const std::string& shape, const std::string& meshes_dir)
 {
   if (shape != "bunny" && shape != "box" && shape != "lshape")
     throw std::invalid_argument("unknown shape '" + shape + "' (bunny, box or lshape)");
@@ -111,7 +111,7 @@ Body3 load_body3(const std::string& shape, const std::string& meshes_dir, bool a
   body.mass = kDensity * mp.volume;
   body.sphere_radius = body.bounding_radius;
   body.sphere_radius_note = "the bounding radius (no statistical table)";
-  describe_table3(shape, allow_synthetic, body);
+  describe_table3(shape, body);
   body.inertia = mp.principal_moments * (body.mass / mp.volume);
   return body;
 }
@@ -148,16 +148,14 @@ const std::vector<std::string>& methods2()
   static const std::vector<std::string> m{"polygon", "circle", "statistical", "statistical-sap", "statistical-grid"};
   return m;
 }
-/// The benchmark's methods, plus statsim with its other broad phase when the runtime has a choice.
+/// The benchmark's methods, plus statsim forced to each broad phase that is not its default.
 std::vector<std::string> default_methods(int dim)
 {
   std::vector<std::string> m = dim == 2 ? std::vector<std::string>{"polygon", "circle", "statistical"}
                                         : std::vector<std::string>{"full", "low", "spheres7", "sphere", "statistical"};
-  if (statsim_has_broad_phase_switch()) {
-    const std::string d = statsim_default_broad_phase();
-    if (d != "grid") m.push_back("statistical-grid");
-    if (d != "sap") m.push_back("statistical-sap");
-  }
+  const std::string d = statsim_default_broad_phase();
+  if (d != "grid") m.push_back("statistical-grid");
+  if (d != "sap") m.push_back("statistical-sap");
   return m;
 }
 
@@ -246,7 +244,7 @@ public:
     std::vector<std::string> methods = o_.methods.empty() ? default_methods(o_.dim) : o_.methods;
 
     if (o_.dim == 3) {
-      body3_ = load_body3(o_.shape, o_.meshes_dir, o_.allow_synthetic);
+      body3_ = load_body3(o_.shape, o_.meshes_dir);
       bullet_shapes_ = make_bullet_shapes(body3_);
       result.settings.push_back("shape " + o_.shape + ": bounding radius " + fmt("%.4g m", body3_.bounding_radius) +
                                 ", mass " + fmt("%.4g kg", body3_.mass) + "; statistical table " + body3_.table_name);
@@ -260,7 +258,7 @@ public:
       }
       for (auto& s : bullet_settings(body3_)) result.settings.push_back(s);
     } else {
-      describe_table2(o_.allow_synthetic, body2_);
+      describe_table2(body2_);
       if (body2_.circle_radius <= 0) {
         body2_.circle_radius = body2_.bounding_radius;
         body2_.circle_radius_note = "the bounding radius (no statistical table)";
@@ -271,8 +269,7 @@ public:
     }
     result.settings.push_back(
         "statsim: WorldDef defaults (broad phase " + statsim_default_broad_phase() +
-        (statsim_has_broad_phase_switch() ? "; statistical-sap / statistical-grid force sweep-and-prune / the grid"
-                                          : "") +
+        "; statistical-sap / statistical-grid force sweep-and-prune / the grid" +
         "; 4 support passes, shock propagation, sleep speed 0.05 m/s for 0.5 s), ground plane, float; world "
         "capacity: the smallest of 16, 128, 1024, 4096, 16384, 32768 holding N, 32 candidate pairs per body; "
         "seed = scene seed");
@@ -295,21 +292,12 @@ public:
       for (const std::string& bp : bps) {
         std::string why_not;
         if (engine == "bullet" && !bullet_supports(*bullet_shapes_, m, why_not)) unavailable_[m + "/" + bp] = why_not;
-        if (engine == "statsim" && !forced_broad_phase(m).empty() && !statsim_has_broad_phase_switch())
-          unavailable_[m + "/" + bp] = "this statsim runtime has no broad-phase switch (WorldDef::broad_phase)";
         if (engine == "statsim" && !(o_.dim == 3 ? body3_.has_table : body2_.has_table))
           unavailable_[m + "/" + bp] =
-              "statistical table missing (" + (o_.dim == 3 ? body3_.table_name : body2_.table_name) +
-              "); generate it, or pass --allow-synthetic to time the synthetic stand-in";
+              "statistical table missing (" + (o_.dim == 3 ? body3_.table_name : body2_.table_name) + ")";
         kinds_.push_back({m, engine, bp});
       }
     }
-    if (o_.dim == 3 && body3_.synthetic_table)
-      result.settings.push_back("WARNING: statistical uses the synthetic cube table as a stand-in for the missing " +
-                                o_.shape + " table: its timings are indicative only");
-    if (o_.dim == 2 && body2_.synthetic_table)
-      result.settings.push_back(
-          "WARNING: statistical uses the synthetic square table as a stand-in for the missing square2d table");
     for (const auto& [key, why] : unavailable_)
       if (o_.progress) std::fprintf(stderr, "statsim bench: %s: %s\n", key.c_str(), why.c_str());
 
@@ -342,7 +330,6 @@ private:
     c += " --dt " + fmt("%.9g", o_.dt) + " --steps " + std::to_string(o_.steps) + " --warmup " +
          std::to_string(o_.warmup) + " --repeat " + std::to_string(o_.repeats) + " --limit-ms " +
          fmt("%g", o_.limit_ms) + " --budget-s " + fmt("%g", o_.budget_s) + " --seed " + std::to_string(o_.seed);
-    if (o_.allow_synthetic) c += " --allow-synthetic";
     return c;
   }
 

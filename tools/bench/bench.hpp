@@ -7,8 +7,9 @@
 //   hull        Bullet, btConvexHullShape of bunny_low.obj's vertices (what a game would use)
 //   spheres7    Bullet, btCompoundShape of the 7 spheres of bunny_spheres7.txt
 //   sphere      Bullet, one btSphereShape (radius: the table's mean collision radius at zero spin)
-//   statistical statsim World3 with the shape's table and the runtime's default broad phase (the
-//               hashed grid); statistical-sap and statistical-grid force one of its two
+//   statistical statsim World3 with the shape's table and the runtime's default broad phase
+//               (BroadPhase::automatic: sweep-and-prune up to WorldDef::grid_above_bodies bodies,
+//               the hashed grid above); statistical-sap and statistical-grid force one of the two
 // 2D (--dim 2, squares): polygon (Box2D b2PolygonShape), circle (Box2D b2CircleShape), statistical
 // (statsim World2 with the square2d table).
 //
@@ -53,7 +54,6 @@ struct BenchOptions {
   double budget_s = 300.0;           ///< stop repeating a cell after this much timed time
   std::uint64_t seed = 1;            ///< of the scene (and of statsim's random streams)
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes
-  bool allow_synthetic = false;      ///< use the synthetic cube / square signature if a table is missing
   bool progress = true;              ///< progress lines on stderr
   bool chart_cpu = false;            ///< chart the thread CPU time instead of the wall-clock median
 };

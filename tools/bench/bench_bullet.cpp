@@ -1,6 +1,6 @@
 // The Bullet methods of the benchmark (full, low, hull, spheres7, sphere) and the settings that
-// make Bullet fair to a 20 cm body. Every value set here is listed by bullet_settings(), which the
-// report prints; the reasons are in the comments below.
+// make Bullet fair to a 20 cm body: bullet_drop_settings() chooses them, tools/bullet's drop world
+// builds them, bullet_settings() lists every value for the report. The reasons are below.
 //
 // Settings (Bullet's defaults are tuned for 1 m bodies):
 //  - margins 0.002 m (1% of the bunny's 0.2 m extent) on GImpact meshes, convex hulls and boxes,
@@ -9,7 +9,7 @@
 //    is the radius).
 //  - contact breaking threshold: left at gContactBreakingThreshold = 0.02 with Bullet's default
 //    relative threshold (CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD), so manifolds break at 0.02 x
-//    the shape's angular motion disc (about 3 to 4 mm for the bunny; the report prints the value);
+//    the shape's angular motion disc (the report prints the value for each shape);
 //    Bullet also pads every AABB by the 0.02 m.
 //  - sleeping: linear threshold = statsim's sleep_speed (0.05 m/s, Bullet default 0.8), angular
 //    threshold = sleep_speed / bounding radius (statsim compares |w| R with sleep_speed; Bullet
@@ -40,11 +40,12 @@
 //  - GImpact: btGImpactCollisionAlgorithm registered on the dispatcher; one shape shared by all
 //    bodies (its BVH is in the body frame).
 #include "bench/bench_internal.hpp"
-#include "bench/bullet.hpp"
+#include "bullet/bullet.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -53,19 +54,18 @@
 namespace statsim::tools::bench {
 
 namespace {
-constexpr double kMargin = 0.002;
-constexpr double kGravity = 9.81;
-
-btVector3 bt(const Eigen::Vector3d& v)
-{
-  return btVector3(v.x(), v.y(), v.z());
-}
-
 std::string fmt(const char* format, double a)
 {
   char buf[256];
   std::snprintf(buf, sizeof buf, format, a);
   return buf;
+}
+
+std::vector<bullet::Shapes::Box> boxes_of(const Body3& body)
+{
+  std::vector<bullet::Shapes::Box> out;
+  for (const Body3::Box& b : body.boxes) out.push_back({b.centre, b.rotation, b.half_extents});
+  return out;
 }
 }  // namespace
 
@@ -73,250 +73,99 @@ class BulletShapes {
 public:
   explicit BulletShapes(const Body3& body) : body_(body)
   {
-    ground_ = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
-    if (!body.full_indices.empty() && body.boxes.empty()) {
-      full_ = make_gimpact(body.full_vertices, body.full_indices, full_v_, full_i_, full_array_);
-    }
-    if (!body.boxes.empty()) full_box_ = make_boxes(body.boxes);
-    if (!body.low_indices.empty()) low_ = make_gimpact(body.low_vertices, body.low_indices, low_v_, low_i_, low_array_);
-    // Convex hull of the low mesh (bunny) or of the full mesh (box, lshape).
-    const std::vector<Eigen::Vector3d>& hv = body.low_vertices.empty() ? body.full_vertices : body.low_vertices;
-    if (!hv.empty()) {
-      hull_ = std::make_unique<btConvexHullShape>();
-      for (const auto& p : hv) hull_->addPoint(bt(p), false);
-      hull_->recalcLocalAabb();
-      hull_->setMargin(kMargin);
-    }
-    if (!body.spheres.empty()) {
-      spheres_ = std::make_unique<btCompoundShape>();
-      for (const auto& s : body.spheres) {
-        sphere_children_.push_back(std::make_unique<btSphereShape>(s[3]));
-        btTransform t;
-        t.setIdentity();
-        t.setOrigin(btVector3(s[0], s[1], s[2]));
-        spheres_->addChildShape(t, sphere_children_.back().get());
-      }
-    }
-    sphere_ = std::make_unique<btSphereShape>(body.sphere_radius);
-    inertia_ = bt(body.inertia);
+    if (!body.full_indices.empty() && body.boxes.empty()) full_ = store_.mesh(body.full_vertices, body.full_indices);
+    if (!body.boxes.empty()) full_ = store_.boxes(boxes_of(body));
+    if (!body.low_indices.empty()) low_ = store_.mesh(body.low_vertices, body.low_indices);
+    const std::vector<Eigen::Vector3d>& hv = hull_points(body);
+    if (!hv.empty()) hull_ = store_.hull(hv);
+    if (!body.spheres.empty()) spheres_ = store_.spheres(body.spheres);
+    sphere_ = store_.sphere(body.sphere_radius);
+  }
+
+  /// Convex hull of the low mesh (bunny) or of the full mesh (box, lshape).
+  static const std::vector<Eigen::Vector3d>& hull_points(const Body3& body)
+  {
+    return body.low_vertices.empty() ? body.full_vertices : body.low_vertices;
   }
 
   btCollisionShape* shape(const std::string& method) const
   {
-    if (method == "full") return full_box_ ? full_box_.get() : static_cast<btCollisionShape*>(full_.get());
-    if (method == "low") return low_.get();
-    if (method == "hull") return hull_.get();
-    if (method == "spheres7") return spheres_.get();
-    if (method == "sphere") return sphere_.get();
+    if (method == "full") return full_;
+    if (method == "low") return low_;
+    if (method == "hull") return hull_;
+    if (method == "spheres7") return spheres_;
+    if (method == "sphere") return sphere_;
     return nullptr;
   }
-  btCollisionShape* ground() const { return ground_.get(); }
   const Body3& body() const { return body_; }
-  const btVector3& inertia() const { return inertia_; }
 
 private:
-  std::unique_ptr<btGImpactMeshShape> make_gimpact(const std::vector<Eigen::Vector3d>& vertices,
-                                                   const std::vector<int>& indices, std::vector<btScalar>& v,
-                                                   std::vector<int>& i,
-                                                   std::unique_ptr<btTriangleIndexVertexArray>& array)
-  {
-    for (const auto& p : vertices) v.insert(v.end(), {p.x(), p.y(), p.z()});
-    i = indices;
-    array = std::make_unique<btTriangleIndexVertexArray>(static_cast<int>(i.size() / 3), i.data(),
-                                                         static_cast<int>(3 * sizeof(int)),
-                                                         static_cast<int>(vertices.size()), v.data(),
-                                                         static_cast<int>(3 * sizeof(btScalar)));
-    auto shape = std::make_unique<btGImpactMeshShape>(array.get());
-    shape->setMargin(kMargin);
-    shape->updateBound();
-    return shape;
-  }
-
-  std::unique_ptr<btCollisionShape> make_boxes(const std::vector<Body3::Box>& boxes)
-  {
-    const bool single = boxes.size() == 1 && boxes[0].centre.norm() < 1e-12 &&
-                        (boxes[0].rotation - Eigen::Matrix3d::Identity()).norm() < 1e-12;
-    if (single) {
-      auto box = std::make_unique<btBoxShape>(bt(boxes[0].half_extents));
-      box->setMargin(kMargin);
-      return box;
-    }
-    auto compound = std::make_unique<btCompoundShape>();
-    for (const auto& b : boxes) {
-      box_children_.push_back(std::make_unique<btBoxShape>(bt(b.half_extents)));
-      box_children_.back()->setMargin(kMargin);
-      const Eigen::Matrix3d& r = b.rotation;
-      btMatrix3x3 basis(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2));
-      compound->addChildShape(btTransform(basis, bt(b.centre)), box_children_.back().get());
-    }
-    return compound;
-  }
-
   Body3 body_;
-  std::vector<btScalar> full_v_, low_v_;
-  std::vector<int> full_i_, low_i_;
-  std::unique_ptr<btTriangleIndexVertexArray> full_array_, low_array_;
-  std::unique_ptr<btGImpactMeshShape> full_, low_;
-  std::unique_ptr<btCollisionShape> full_box_;
-  std::vector<std::unique_ptr<btBoxShape>> box_children_;
-  std::unique_ptr<btConvexHullShape> hull_;
-  std::unique_ptr<btCompoundShape> spheres_;
-  std::vector<std::unique_ptr<btSphereShape>> sphere_children_;
-  std::unique_ptr<btSphereShape> sphere_;
-  std::unique_ptr<btStaticPlaneShape> ground_;
-  btVector3 inertia_;
+  bullet::Shapes store_;
+  btCollisionShape* full_ = nullptr;
+  btCollisionShape* low_ = nullptr;
+  btCollisionShape* hull_ = nullptr;
+  btCollisionShape* spheres_ = nullptr;
+  btCollisionShape* sphere_ = nullptr;
 };
 
 namespace {
 
-/// btDiscreteDynamicsWorld with the collision phase timed: the same calls as
-/// btCollisionWorld::performDiscreteCollisionDetection (update AABBs, find overlapping pairs,
-/// dispatch the pairs to the narrow phase), with a clock read between them.
-class TimedWorld final : public btDiscreteDynamicsWorld {
-public:
-  using btDiscreteDynamicsWorld::btDiscreteDynamicsWorld;
-
-  void performDiscreteCollisionDetection() override
-  {
-    const Clock::time_point t0 = Clock::now();
-    updateAabbs();
-    computeOverlappingPairs();
-    const Clock::time_point t1 = Clock::now();
-    btDispatcher* dispatcher = getDispatcher();
-    if (dispatcher)
-      dispatcher->dispatchAllCollisionPairs(m_broadphasePairCache->getOverlappingPairCache(), getDispatchInfo(),
-                                            m_dispatcher1);
-    const Clock::time_point t2 = Clock::now();
-    phases.broad += elapsed_ns(t0, t1);
-    phases.narrow += elapsed_ns(t1, t2);
-  }
-
-  PhaseTimes phases{0, 0};
-};
-
 class BulletSim final : public Sim {
 public:
-  BulletSim(const std::shared_ptr<BulletShapes>& shapes, const std::string& method, const std::string& broadphase,
-            const scenes::DropScene3& scene, double dt)
-      : shapes_(shapes), dt_(dt)
+  BulletSim(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
+            const bullet::DropSettings& settings, const std::vector<scenes::BodyState3>& states, double dt)
+      : shapes_(shapes), method_(method), dt_(dt)
   {
     const Body3& body = shapes->body();
-    btCollisionShape* shape = shapes->shape(method);
-    if (!shape) throw std::runtime_error("Bullet: no shape for method " + method);
-    const int n = static_cast<int>(scene.bodies.size());
-
-    btDefaultCollisionConstructionInfo cci;
-    cci.m_defaultMaxPersistentManifoldPoolSize = std::max(4096, 4 * n);
-    cci.m_defaultMaxCollisionAlgorithmPoolSize = std::max(4096, 4 * n);
-    config_ = std::make_unique<btDefaultCollisionConfiguration>(cci);
-    dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
-    btGImpactCollisionAlgorithm::registerAlgorithm(dispatcher_.get());
-    if (broadphase == "sap") {
-      if (n + 2 <= 16000)
-        broadphase_ = std::make_unique<btAxisSweep3>(bt(scene.bounds_lo), bt(scene.bounds_hi),
-                                                     static_cast<unsigned short>(n + 2));
-      else
-        broadphase_ = std::make_unique<bt32BitAxisSweep3>(bt(scene.bounds_lo), bt(scene.bounds_hi),
-                                                          static_cast<unsigned int>(n + 2));
-    } else if (broadphase == "dbvt") {
-      broadphase_ = std::make_unique<btDbvtBroadphase>();
-    } else {
-      throw std::runtime_error("Bullet: unknown broad phase " + broadphase);
-    }
-    solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-    world_ = std::make_unique<TimedWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(), config_.get());
-    world_->setGravity(btVector3(0, 0, -kGravity));
-    world_->setForceUpdateAllAabbs(false);
-    world_->getSolverInfo().m_restitutionVelocityThreshold = body.surface.restitution_threshold;
-    gDeactivationTime = body.surface.sleep_time;
-
-    const double friction = std::sqrt(body.surface.friction);
-    const double restitution = std::sqrt(body.surface.restitution);
-    {
-      btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, shapes->ground());
-      info.m_friction = friction;
-      info.m_restitution = restitution;
-      ground_ = std::make_unique<btRigidBody>(info);
-      world_->addRigidBody(ground_.get());
-    }
-    const double rolling = method == "sphere" && friction > 0
-                               ? body.surface.rolling_resistance * body.sphere_radius / friction
-                               : 0.0;
-    bodies_.reserve(scene.bodies.size());
-    for (const scenes::BodyState3& s : scene.bodies) {
-      btRigidBody::btRigidBodyConstructionInfo info(body.mass, nullptr, shape, shapes->inertia());
-      info.m_friction = friction;
-      info.m_restitution = restitution;
-      info.m_rollingFriction = rolling;
-      info.m_linearSleepingThreshold = body.surface.sleep_speed;
-      info.m_angularSleepingThreshold = body.surface.sleep_speed / body.bounding_radius;
-      const Eigen::Quaterniond& q = s.orientation;
-      info.m_startWorldTransform = btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), bt(s.position));
-      auto rb = std::make_unique<btRigidBody>(info);
-      rb->setLinearVelocity(bt(s.linear_velocity));
-      rb->setAngularVelocity(bt(s.angular_velocity));
-      world_->addRigidBody(rb.get());
-      bodies_.push_back(std::move(rb));
-    }
+    bullet::DropBody b;
+    b.shape = shapes->shape(method);
+    if (!b.shape) throw std::runtime_error("Bullet: no shape for method " + method);
+    b.mass = body.mass;
+    b.inertia = body.inertia;
+    b.bounding_radius = body.bounding_radius;
+    world_ = std::make_unique<bullet::DropWorld>(b, states, settings);
   }
 
-  ~BulletSim() override
-  {
-    // The world's destructor removes the proxies of its objects; the bodies go after it.
-    world_.reset();
-  }
-
-  void step() override
-  {
-    world_->phases = PhaseTimes{0, 0};
-    world_->stepSimulation(dt_, 0);
-  }
-  PhaseTimes phases() const override { return world_->phases; }
-  std::size_t asleep() const override
-  {
-    std::size_t k = 0;
-    for (const auto& b : bodies_) k += b->getActivationState() == ISLAND_SLEEPING;
-    return k;
-  }
-  std::size_t body_count() const override { return bodies_.size(); }
-  scenes::BodyState3 body_state(std::size_t i) const override
-  {
-    const btRigidBody& b = *bodies_[i];
-    const btVector3& p = b.getCenterOfMassPosition();
-    const btQuaternion q = b.getOrientation();
-    const btVector3& v = b.getLinearVelocity();
-    const btVector3& w = b.getAngularVelocity();
-    scenes::BodyState3 s;
-    s.position = Eigen::Vector3d(p.x(), p.y(), p.z());
-    s.orientation = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
-    s.linear_velocity = Eigen::Vector3d(v.x(), v.y(), v.z());
-    s.angular_velocity = Eigen::Vector3d(w.x(), w.y(), w.z());
-    return s;
-  }
-  bool body_asleep(std::size_t i) const override { return bodies_[i]->getActivationState() == ISLAND_SLEEPING; }
+  void step() override { world_->step(dt_); }
+  PhaseTimes phases() const override { return PhaseTimes{world_->broad_ns(), world_->narrow_ns()}; }
+  std::size_t asleep() const override { return world_->asleep_count(); }
+  std::size_t body_count() const override { return world_->size(); }
+  scenes::BodyState3 body_state(std::size_t i) const override { return world_->state(i); }
+  bool body_asleep(std::size_t i) const override { return world_->asleep(i); }
   EndState end_state() const override
   {
     EndState e;
     e.asleep = asleep();
     double z = 0;
-    for (const auto& b : bodies_) z += b->getCenterOfMassPosition().z();
-    e.mean_height = bodies_.empty() ? 0.0 : z / static_cast<double>(bodies_.size());
-    btDispatcher* d = world_->getDispatcher();
-    for (int i = 0; i < d->getNumManifolds(); ++i)
-      e.contacts += d->getManifoldByIndexInternal(i)->getNumContacts() > 0;
+    for (std::size_t i = 0; i < world_->size(); ++i) z += world_->state(i).position.z();
+    e.mean_height = world_->size() == 0 ? 0.0 : z / static_cast<double>(world_->size());
+    e.contacts = world_->touching_pairs();
     return e;
+  }
+  double kinetic_energy() const override
+  {
+    const Body3& body = shapes_->body();
+    double ke = 0;
+    for (std::size_t i = 0; i < world_->size(); ++i) {
+      const scenes::BodyState3 s = world_->state(i);
+      const Eigen::Vector3d wb = s.orientation.conjugate() * s.angular_velocity;
+      ke += 0.5 * body.mass * s.linear_velocity.squaredNorm() + 0.5 * wb.dot(body.inertia.cwiseProduct(wb));
+    }
+    return ke;
+  }
+  double overlap() const override { return world_->deepest_penetration(); }
+  double lowest(std::size_t i) const override
+  {
+    const scenes::BodyState3 s = world_->state(i);
+    return s.position.z() + lowest_offset(shapes_->body(), method_, s.orientation);
   }
 
 private:
-  std::shared_ptr<BulletShapes> shapes_;
+  std::shared_ptr<BulletShapes> shapes_;  // outlives the world, which points to its shapes
+  std::string method_;
   double dt_;
-  std::unique_ptr<btDefaultCollisionConfiguration> config_;
-  std::unique_ptr<btCollisionDispatcher> dispatcher_;
-  std::unique_ptr<btBroadphaseInterface> broadphase_;
-  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
-  std::unique_ptr<btRigidBody> ground_;
-  std::vector<std::unique_ptr<btRigidBody>> bodies_;
-  std::unique_ptr<TimedWorld> world_;  // destroyed first (declared last), see ~BulletSim
+  std::unique_ptr<bullet::DropWorld> world_;
 };
 
 }  // namespace
@@ -335,10 +184,56 @@ bool bullet_supports(const BulletShapes& shapes, const std::string& method, std:
   return false;
 }
 
+double lowest_offset(const Body3& body, const std::string& method, const Eigen::Quaterniond& q)
+{
+  const Eigen::Matrix3d r = q.toRotationMatrix();
+  double lo = std::numeric_limits<double>::infinity();
+  if (method == "full" || method == "low" || method == "hull") {
+    const auto& vs = method == "full" ? body.full_vertices
+                                      : (method == "low" ? body.low_vertices : BulletShapes::hull_points(body));
+    for (const auto& p : vs) lo = std::min(lo, r.row(2).dot(p));
+  } else if (method == "spheres7") {
+    for (const auto& s : body.spheres) lo = std::min(lo, r.row(2).dot(s.head<3>()) - s[3]);
+  } else {
+    lo = -body.sphere_radius;
+  }
+  return lo;
+}
+
+bullet::DropSettings bullet_drop_settings(const Body3& body, const std::string& method, const std::string& broadphase,
+                                          const scenes::DropScene3& scene)
+{
+  bullet::DropSettings s;
+  if (broadphase == "sap") {
+    s.broad_phase = bullet::BroadPhase::sap;
+    s.bounds_lo = scene.bounds_lo;
+    s.bounds_hi = scene.bounds_hi;
+  } else if (broadphase != "dbvt") {
+    throw std::runtime_error("Bullet: unknown broad phase " + broadphase);
+  }
+  s.restitution = body.surface.restitution;
+  s.friction = body.surface.friction;
+  s.rolling_resistance = body.surface.rolling_resistance;
+  s.rolling_radius = method == "sphere" ? body.sphere_radius : 0.0;
+  s.restitution_threshold = body.surface.restitution_threshold;
+  s.sleep_speed = body.surface.sleep_speed;
+  s.sleep_time = body.surface.sleep_time;
+  s.update_all_aabbs = false;
+  return s;
+}
+
+std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
+                                 const bullet::DropSettings& settings, const std::vector<scenes::BodyState3>& states,
+                                 double dt)
+{
+  return std::make_unique<BulletSim>(shapes, method, settings, states, dt);
+}
+
 std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
                                  const std::string& broadphase, const scenes::DropScene3& scene, double dt)
 {
-  return std::make_unique<BulletSim>(shapes, method, broadphase, scene, dt);
+  return make_bullet(shapes, method, bullet_drop_settings(shapes->body(), method, broadphase, scene), scene.bodies,
+                     dt);
 }
 
 std::vector<std::string> bullet_settings(const Body3& body)
@@ -350,7 +245,7 @@ std::vector<std::string> bullet_settings(const Body3& body)
               "starting); gravity (0, 0, -9.81) m/s^2; no CCD; stepSimulation(dt, 0) = one internal step of dt");
   s.push_back(fmt("Bullet margins: %.3g m on GImpact meshes, convex hulls and boxes (default 0.04); spheres: "
                   "none (the radius)",
-                  kMargin));
+                  bullet::kMargin));
   {
     // The contact breaking threshold Bullet will use for this body's manifolds.
     BulletShapes shapes(body);

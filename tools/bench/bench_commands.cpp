@@ -124,8 +124,6 @@ void register_bench_commands(CLI::App& app)
       ->capture_default_str();
   b->add_option("--seed", o.seed, "Scene seed (and statsim's random streams)")->capture_default_str();
   b->add_option("--meshes", o.meshes_dir, "Directory of bunny.obj etc. (default: the source tree's tools/meshes)");
-  b->add_flag("--allow-synthetic", o.allow_synthetic,
-              "Time the synthetic test signature when the shape's table is not generated yet (indicative only)");
   b->add_option("--csv", cmd->csv, "Write the CSV here");
   b->add_option("--chart", cmd->chart, "Write the log-log chart here as PNG, and as SVG beside it (FILE.svg)");
   b->add_option("--replot", cmd->replot, "Only redraw --chart from the CSV of an earlier run (--shape names the shape in the title)");

@@ -3,13 +3,16 @@
 #pragma once
 
 #include "bench/bench.hpp"
+#include "bullet/drop_world.hpp"
 #include "scenes/scenes.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <chrono>
 #include <ctime>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,8 +32,8 @@ inline std::int64_t elapsed_ns(Clock::time_point a, Clock::time_point b)
 }
 
 /// CPU time this thread has used, ms (CLOCK_THREAD_CPUTIME_ID): on a shared machine it leaves out
-/// the time spent waiting for a core. Read once per repeat: each read is a system call (about
-/// 1.3 us here), too slow to bracket single steps of a few microseconds.
+/// the time spent waiting for a core. Read once per repeat: each read is a system call, too slow
+/// to bracket single steps of a few microseconds.
 inline double thread_cpu_ms()
 {
   timespec t{};
@@ -78,6 +81,18 @@ public:
     (void)i;
     return false;
   }
+  // Measurements of `statsim stress`, read between steps; NaN where a method does not give them.
+  /// Kinetic energy of all bodies, J.
+  virtual double kinetic_energy() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// Deepest overlap now: Bullet the deepest contact point of any manifold (m); statsim between
+  /// collision spheres (fraction of their radius sum).
+  virtual double overlap() const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// Height of the lowest point of body i above z = 0, m (negative: below the ground).
+  virtual double lowest(std::size_t i) const
+  {
+    (void)i;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
 };
 
 /// Material and thresholds every method uses, from the statistical table (or defaults).
@@ -114,7 +129,6 @@ struct Body3 {
   std::string sphere_radius_note;         ///< where it comes from
   Surface surface;
   bool has_table = false;                 ///< a statistical table is compiled in for the shape
-  bool synthetic_table = false;           ///< the table is tools/scenes/synthetic_signatures.hpp's cube
   std::string table_name;
 };
 
@@ -127,23 +141,21 @@ struct Body2 {
   std::string circle_radius_note;
   Surface surface;
   bool has_table = false;
-  bool synthetic_table = false;
   std::string table_name;
 };
 
 // ---- statsim (bench_statsim.cpp) -----------------------------------------------------------------
 /// Fills the table-derived fields of `body` (has_table, mass, sphere radius, surface) for
-/// `shape`; `allow_synthetic` uses the synthetic cube when the shape's table is missing.
-void describe_table3(const std::string& shape, bool allow_synthetic, Body3& body);
-void describe_table2(bool allow_synthetic, Body2& body);
+/// `shape` from its committed table.
+void describe_table3(const std::string& shape, Body3& body);
+/// The same from tables/square2d.hpp.
+void describe_table2(Body2& body);
 /// Largest N the statsim worlds of the benchmark hold.
 std::uint32_t statsim_capacity();
-/// True when this runtime lets WorldDef choose its broad phase (grid or sweep-and-prune).
-bool statsim_has_broad_phase_switch();
-/// The runtime's default broad phase: "grid" or "sap".
+/// The runtime's default broad phase: "auto" (BroadPhase::automatic), "grid" or "sap".
 std::string statsim_default_broad_phase();
-/// The statistical table compiled in for `shape` (or the synthetic cube when allowed); false if none.
-bool statsim_table3(const std::string& shape, bool allow_synthetic, SignatureView<3>& out);
+/// The statistical table compiled in for `shape`; false if none.
+bool statsim_table3(const std::string& shape, SignatureView<3>& out);
 /// WorldDef variations of the statistical methods that `statsim fidelity` compares.
 struct StatsimVariant {
   bool rest_conditions = true;     ///< WorldDef::rest_conditions
@@ -165,8 +177,20 @@ class BulletShapes;
 std::shared_ptr<BulletShapes> make_bullet_shapes(const Body3& body);
 /// True when `method` can be built for the body (e.g. spheres7 needs the sphere file).
 bool bullet_supports(const BulletShapes& shapes, const std::string& method, std::string& why_not);
+/// The benchmark's Bullet world for `method`: the table's material and thresholds, the ground
+/// z = 0, `broadphase` "sap" (within the scene's bounds) or "dbvt".
+bullet::DropSettings bullet_drop_settings(const Body3& body, const std::string& method, const std::string& broadphase,
+                                          const scenes::DropScene3& scene);
+/// A Bullet world of the benchmark's settings; step() advances it by dt.
 std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
                                  const std::string& broadphase, const scenes::DropScene3& scene, double dt);
+/// A Bullet world of other settings (e.g. bullet_drop_settings() with walls) from these states.
+std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
+                                 const bullet::DropSettings& settings, const std::vector<scenes::BodyState3>& states,
+                                 double dt);
+/// Lowest point of `method`'s representation of the body below its centre for orientation q, m:
+/// the minimum over its geometry of (R p).z (negative).
+double lowest_offset(const Body3& body, const std::string& method, const Eigen::Quaterniond& q);
 /// Every Bullet setting the benchmark makes, one per line, for the report.
 std::vector<std::string> bullet_settings(const Body3& body);
 
@@ -177,6 +201,6 @@ std::vector<std::string> box2d_settings(const Body2& body);
 
 // ---- loading (bench.cpp) -------------------------------------------------------------------------
 /// Loads the meshes of `shape` from `meshes_dir` into the body frame. Throws std::runtime_error.
-Body3 load_body3(const std::string& shape, const std::string& meshes_dir, bool allow_synthetic);
+Body3 load_body3(const std::string& shape, const std::string& meshes_dir);
 
 }  // namespace statsim::tools::bench

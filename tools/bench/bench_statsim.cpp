@@ -5,100 +5,40 @@
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 
-// Tables are compiled in when they exist, so the tool builds before they are generated.
-#if __has_include("tables/bunny.hpp")
-#include "tables/bunny.hpp"
-#define STATSIM_BENCH_HAVE_BUNNY 1
-#endif
-#if __has_include("tables/box.hpp")
 #include "tables/box.hpp"
-#define STATSIM_BENCH_HAVE_BOX 1
-#endif
-#if __has_include("tables/lshape.hpp")
+#include "tables/bunny.hpp"
 #include "tables/lshape.hpp"
-#define STATSIM_BENCH_HAVE_LSHAPE 1
-#endif
-#if __has_include("tables/square2d.hpp")
 #include "tables/square2d.hpp"
-#define STATSIM_BENCH_HAVE_SQUARE2D 1
-#endif
-#include "scenes/synthetic_signatures.hpp"
 
 #include <cmath>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <type_traits>
 #include <utility>
 
 namespace statsim::tools::bench {
 namespace {
 
 // Capacities: the world is sized to the scene (the smallest of these tiers that holds N), as a user
-// would size it; candidate pairs up to 32 per body (bounding spheres of a pile of bunnies overlap
-// about a dozen neighbours each; an overflow is reported, never silent).
+// would size it; candidate pairs up to 32 per body, room for the neighbours whose bounding spheres
+// overlap in a pile (see tools/bench/README.md); an overflow is reported, never silent.
 constexpr std::uint32_t kCapacity = 32768;
 constexpr std::uint32_t kPairsPerBody = 32;
 
-// The runtime's broad-phase switch (WorldDef::broad_phase), when this runtime has one.
-template <class Def, class = void>
-struct HasBroadPhase : std::false_type {};
-template <class Def>
-struct HasBroadPhase<Def, std::void_t<decltype(std::declval<Def&>().broad_phase)>> : std::true_type {};
-
 /// Sets the broad phase: "" keeps the runtime's default; "grid" or "sap" forces one.
-template <class Def>
-void set_broad_phase(Def& def, const std::string& which)
+void set_broad_phase(BroadPhase& broad_phase, const std::string& which)
 {
   if (which.empty()) return;
-  if constexpr (HasBroadPhase<Def>::value) {
-    using Kind = decltype(def.broad_phase);
-    def.broad_phase = which == "grid" ? Kind::grid : Kind::sweep_and_prune;
-  } else if (which != "sap") {
-    throw std::runtime_error("this statsim runtime has no " + which + " broad phase");
-  }
+  broad_phase = which == "grid" ? BroadPhase::grid : BroadPhase::sweep_and_prune;
 }
 
-struct Table3 {
-  SignatureView<3> view;
-  bool synthetic = false;
-};
-
-std::optional<Table3> table3(const std::string& shape, bool allow_synthetic)
+std::optional<SignatureView<3>> table3(const std::string& shape)
 {
-  (void)shape;  // unused when no 3D table is generated yet
-#ifdef STATSIM_BENCH_HAVE_BUNNY
-  if (shape == "bunny") return Table3{tables::bunny.view(), false};
-#endif
-#ifdef STATSIM_BENCH_HAVE_BOX
-  if (shape == "box") return Table3{tables::box.view(), false};
-#endif
-#ifdef STATSIM_BENCH_HAVE_LSHAPE
-  if (shape == "lshape") return Table3{tables::lshape.view(), false};
-#endif
-  if (allow_synthetic) return Table3{testing::cube_synthetic.view(), true};
+  if (shape == "bunny") return tables::bunny.view();
+  if (shape == "box") return tables::box.view();
+  if (shape == "lshape") return tables::lshape.view();
   return std::nullopt;
-}
-
-std::optional<SignatureView<2>> view2(bool allow_synthetic)
-{
-#ifdef STATSIM_BENCH_HAVE_SQUARE2D
-  (void)allow_synthetic;
-  return tables::square2d.view();
-#else
-  if (allow_synthetic) return testing::square2d_synthetic.view();
-  return std::nullopt;
-#endif
-}
-
-bool view2_synthetic()
-{
-#ifdef STATSIM_BENCH_HAVE_SQUARE2D
-  return false;
-#else
-  return true;
-#endif
 }
 
 template <int D>
@@ -156,7 +96,7 @@ public:
     def.seed = seed;
     def.rest_conditions = variant.rest_conditions;
     if (variant.independent_pairs) def.pair_response = PairResponse::independent;
-    set_broad_phase(def, broad_phase);
+    set_broad_phase(def.broad_phase, broad_phase);
     world_ = std::make_unique<WorldT>(def);
     if (world_->construction_status() != Status::ok)
       throw std::runtime_error(std::string("statsim world: ") + to_string(world_->construction_status()));
@@ -235,72 +175,51 @@ std::uint32_t statsim_capacity()
   return kCapacity;
 }
 
-void describe_table3(const std::string& shape, bool allow_synthetic, Body3& body)
+void describe_table3(const std::string& shape, Body3& body)
 {
-  const std::optional<Table3> t = table3(shape, allow_synthetic);
+  const std::optional<SignatureView<3>> t = table3(shape);
   body.has_table = t.has_value();
   if (!t) {
     body.table_name = "tables/" + shape + ".hpp (missing)";
     return;
   }
-  body.synthetic_table = t->synthetic;
-  body.table_name = t->synthetic ? "tools/scenes/synthetic_signatures.hpp cube_synthetic (stand-in: tables/" + shape +
-                                       ".hpp is missing)"
-                                 : "tables/" + shape + ".hpp";
-  fill_surface<3>(t->view, body.surface);
-  if (!t->synthetic) body.mass = static_cast<double>(t->view.mass);
-  body.sphere_radius = static_cast<double>(t->view.height.mean[0]);
+  body.table_name = "tables/" + shape + ".hpp";
+  fill_surface<3>(*t, body.surface);
+  body.mass = static_cast<double>(t->mass);
+  body.sphere_radius = static_cast<double>(t->height.mean[0]);
   body.sphere_radius_note = "the table's mean collision radius h_coll at spin ratio 0";
-  if (t->synthetic) body.sphere_radius_note += " (synthetic cube table)";
 }
 
-void describe_table2(bool allow_synthetic, Body2& body)
+void describe_table2(Body2& body)
 {
-  const std::optional<SignatureView<2>> v = view2(allow_synthetic);
-  body.has_table = v.has_value();
-  if (!v) {
-    body.table_name = "tables/square2d.hpp (missing)";
-    return;
-  }
-  body.synthetic_table = view2_synthetic();
-  body.table_name = body.synthetic_table
-                        ? "tools/scenes/synthetic_signatures.hpp square2d_synthetic (stand-in: tables/square2d.hpp is missing)"
-                        : "tables/square2d.hpp";
-  fill_surface<2>(*v, body.surface);
-  body.mass = static_cast<double>(v->mass);
-  body.circle_radius = static_cast<double>(v->height.mean[0]);
+  const SignatureView<2> v = tables::square2d.view();
+  body.has_table = true;
+  body.table_name = "tables/square2d.hpp";
+  fill_surface<2>(v, body.surface);
+  body.mass = static_cast<double>(v.mass);
+  body.circle_radius = static_cast<double>(v.height.mean[0]);
   body.circle_radius_note = "the table's mean collision radius h_coll at spin ratio 0";
-}
-
-bool statsim_has_broad_phase_switch()
-{
-  return HasBroadPhase<WorldDef3>::value;
 }
 
 std::string statsim_default_broad_phase()
 {
-  if constexpr (HasBroadPhase<WorldDef3>::value) {
-    using Kind = decltype(WorldDef3{}.broad_phase);
-    const Kind k = WorldDef3{}.broad_phase;
-    return k == Kind::grid ? "grid" : (k == Kind::sweep_and_prune ? "sap" : "auto");
-  } else {
-    return "sap";
-  }
+  const BroadPhase k = WorldDef3{}.broad_phase;
+  return k == BroadPhase::grid ? "grid" : (k == BroadPhase::sweep_and_prune ? "sap" : "auto");
 }
 
 std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
                                    const std::string& broad_phase)
 {
-  const std::optional<Table3> t = table3(body.shape, body.synthetic_table);
+  const std::optional<SignatureView<3>> t = table3(body.shape);
   if (!t) throw std::runtime_error("no statistical table for " + body.shape);
-  return make_sized<3>(t->view, body.mass, scene, seed, dt, broad_phase);
+  return make_sized<3>(*t, body.mass, scene, seed, dt, broad_phase);
 }
 
-bool statsim_table3(const std::string& shape, bool allow_synthetic, SignatureView<3>& out)
+bool statsim_table3(const std::string& shape, SignatureView<3>& out)
 {
-  const std::optional<Table3> t = table3(shape, allow_synthetic);
+  const std::optional<SignatureView<3>> t = table3(shape);
   if (!t) return false;
-  out = t->view;
+  out = *t;
   return true;
 }
 
@@ -314,9 +233,7 @@ std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mas
 std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,
                                    const std::string& broad_phase)
 {
-  const std::optional<SignatureView<2>> v = view2(body.synthetic_table);
-  if (!v) throw std::runtime_error("no statistical table for the square");
-  return make_sized<2>(*v, body.mass, scene, seed, dt, broad_phase);
+  return make_sized<2>(tables::square2d.view(), body.mass, scene, seed, dt, broad_phase);
 }
 
 }  // namespace statsim::tools::bench

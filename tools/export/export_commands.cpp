@@ -1,6 +1,5 @@
-#include "export/export_commands.hpp"
-
 #include "export/gltf_export.hpp"
+
 #include "render/frames.hpp"
 #include "render/render.hpp"
 
@@ -22,33 +21,19 @@ struct ExportArgs {
 
 int run_export(const ExportArgs& a)
 {
-  std::vector<std::string> names;
-  std::stringstream ss(a.shapes);
-  for (std::string item; std::getline(ss, item, ',');) names.push_back(item);
-  render::Frames frames;
+  render::LoadedFrames in;
   std::string error;
-  if (!render::read_frames(a.in, names, frames, error)) {
+  if (!render::load_frames(a.in, a.shapes, a.detail, a.meshes, in, error)) {
     std::fprintf(stderr, "export: %s\n", error.c_str());
     return 1;
   }
+  render::Frames& frames = in.frames;
   if (a.every > 1) {
     std::vector<render::Frame> kept;
     for (std::size_t i = 0; i < frames.frames.size(); i += std::size_t(a.every)) kept.push_back(frames.frames[i]);
     frames.frames = kept;
   }
-  std::vector<std::unique_ptr<render::RenderShape>> owned;
-  std::vector<const render::RenderShape*> shapes;
-  for (const std::string& name : frames.shapes) {
-    auto s = std::make_unique<render::RenderShape>();
-    const std::string mesh = name == "bunny" && a.detail == "low" ? "bunny_low" : name;
-    if (!render::load_render_shape(mesh, a.meshes, *s, error)) {
-      std::fprintf(stderr, "export: %s\n", error.c_str());
-      return 1;
-    }
-    shapes.push_back(s.get());
-    owned.push_back(std::move(s));
-  }
-  if (!exporter::export_glb(frames, shapes, a.gltf, error)) {
+  if (!exporter::export_glb(frames, in.shapes, a.gltf, error)) {
     std::fprintf(stderr, "export: %s\n", error.c_str());
     return 1;
   }

@@ -1,4 +1,5 @@
 // tiny_gltf.h (Debian libtinygltf-dev) with its warnings silenced: include it through this header.
+// tinygltf_impl.cpp includes it once with TINYGLTF_IMPLEMENTATION defined.
 #pragma once
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -9,6 +10,7 @@
 #pragma GCC diagnostic ignored "-Wsign-conversion"
 #pragma GCC diagnostic ignored "-Wshadow"
 #pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
 #endif
 #include <tiny_gltf.h>
 #if defined(__GNUC__)

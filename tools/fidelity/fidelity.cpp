@@ -242,22 +242,30 @@ PileStats pile_stats(const std::vector<PileRun>& m, const std::vector<PileRun>& 
 
 }  // namespace
 
+/// The bootstrap interval of get(stats(method, reference)) over resamples of both samples.
+template <class Run, class Stats, class Get>
+Interval resampled(const std::vector<Run>& method, const std::vector<Run>& reference, const Stats& stats,
+                   const Get& get, int resamples)
+{
+  return bootstrap(
+      method.size(), reference.size(),
+      [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
+        return get(stats(pick(method, ia), pick(reference, ib)));
+      },
+      resamples);
+}
+
 Distances compare(const std::vector<DropRun>& method, const std::vector<DropRun>& reference,
                   const std::vector<PileRun>& method_piles, const std::vector<PileRun>& reference_piles, int configs,
                   int resamples)
 {
   Distances d;
   const DropStats full = drop_stats(method, reference, configs);
-  const std::size_t na = method.size(), nb = reference.size();
   // One resampling per statistic with the same seed: every statistic sees the same resamples.
-  auto ci = [&](auto get) {
-    return bootstrap(
-        na, nb,
-        [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
-          return get(drop_stats(pick(method, ia), pick(reference, ib), configs));
-        },
-        resamples);
+  const auto drops = [&](const std::vector<DropRun>& a, const std::vector<DropRun>& b) {
+    return drop_stats(a, b, configs);
   };
+  auto ci = [&](auto get) { return resampled(method, reference, drops, get, resamples); };
   d.rest_tvd = {full.tvd, ci([](const DropStats& s) { return s.tvd; })};
   d.rest_height_err = {full.height, ci([](const DropStats& s) { return s.height; })};
   d.travel_w1 = {full.travel, ci([](const DropStats& s) { return s.travel; })};
@@ -270,14 +278,10 @@ Distances compare(const std::vector<DropRun>& method, const std::vector<DropRun>
   if (!method_piles.empty() && !reference_piles.empty()) {
     d.piles = true;
     const PileStats p = pile_stats(method_piles, reference_piles, configs);
-    auto pci = [&](auto get) {
-      return bootstrap(
-          method_piles.size(), reference_piles.size(),
-          [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
-            return get(pile_stats(pick(method_piles, ia), pick(reference_piles, ib), configs));
-          },
-          resamples);
+    const auto piles = [&](const std::vector<PileRun>& a, const std::vector<PileRun>& b) {
+      return pile_stats(a, b, configs);
     };
+    auto pci = [&](auto get) { return resampled(method_piles, reference_piles, piles, get, resamples); };
     d.pile_radial_w1 = {p.radial, pci([](const PileStats& s) { return s.radial; })};
     d.pile_height_w1 = {p.height, pci([](const PileStats& s) { return s.height; })};
     d.pile_rest_tvd = {p.tvd, pci([](const PileStats& s) { return s.tvd; })};
@@ -659,8 +663,8 @@ Setup make_setup(const FidelityOptions& o)
   SignatureView<3> compiled{};
   bool have_compiled = false;
   if (o.mesh.empty()) {
-    s.body = bench::load_body3(o.shape, o.meshes_dir, o.allow_synthetic);
-    have_compiled = bench::statsim_table3(o.shape, o.allow_synthetic, compiled);
+    s.body = bench::load_body3(o.shape, o.meshes_dir);
+    have_compiled = bench::statsim_table3(o.shape, compiled);
     if (!have_compiled && s.loaded.empty())
       throw std::runtime_error("no statistical table for " + o.shape + " (generate tables/" + o.shape +
                                ".hpp or pass --table NAME=FILE.json)");
@@ -733,6 +737,29 @@ Setup make_setup(const FidelityOptions& o)
   return s;
 }
 
+/// Runs `per_sample` jobs of each of `samples` samples (0 and 1: the reference's samples A and
+/// B, then the methods) on `threads` threads and hands each result to its sample's MethodResult,
+/// in job order. Job j is run j / samples of sample j % samples: interleaved, so that the
+/// expensive reference runs spread over the whole job list.
+template <class Run, class Keep>
+void run_samples(const char* label, std::size_t samples, std::size_t per_sample, unsigned threads, bool progress_on,
+                 FidelityResult& res, Run run, Keep keep)
+{
+  Progress progress(label, samples * per_sample, progress_on);
+  const auto all = parallel_map(
+      samples * per_sample,
+      [&](std::size_t job) {
+        auto result = run(job % samples, job / samples);
+        progress.add();
+        return result;
+      },
+      threads);
+  for (std::size_t job = 0; job < all.size(); ++job) {
+    const std::size_t sample = job % samples;
+    keep(sample == 0 ? res.reference : sample == 1 ? res.reference_b : res.methods[sample - 2], all[job]);
+  }
+}
+
 }  // namespace
 
 FidelityResult run_fidelity(const FidelityOptions& options)
@@ -786,29 +813,16 @@ FidelityResult run_fidelity(const FidelityOptions& options)
   const std::size_t runs = static_cast<std::size_t>(options.runs);
   const std::size_t samples = 2 + setup->methods.size();
   const unsigned threads = resolve_thread_count(options.threads);
-  {
-    Progress progress("fidelity: single drops", samples * runs, options.progress);
-    const std::vector<DropRun> all = parallel_map(
-        samples * runs,
-        [&](std::size_t job) {
-          // Interleave: job j is run j / samples of sample j % samples, so that the expensive
-          // reference runs spread over the whole job list.
-          const std::size_t sample = job % samples, r = job / samples;
-          const MethodSpec& m = sample < 2 ? ref : setup->methods[sample - 2];
-          const double dt = sample < 2 ? options.reference_dt : options.dt;
-          const std::uint64_t index = r + (sample == 1 ? kSampleB : 0);
-          DropRun d = run_single(*setup, m, mix(options.seed, index), dt, options.time_limit);
-          progress.add();
-          return d;
-        },
-        threads);
-    res.methods.resize(setup->methods.size());
-    for (std::size_t job = 0; job < all.size(); ++job) {
-      const std::size_t sample = job % samples;
-      MethodResult& mr = sample == 0 ? res.reference : sample == 1 ? res.reference_b : res.methods[sample - 2];
-      mr.drops.push_back(all[job]);
-    }
-  }
+  res.methods.resize(setup->methods.size());
+  run_samples(
+      "fidelity: single drops", samples, runs, threads, options.progress, res,
+      [&](std::size_t sample, std::size_t r) {
+        const MethodSpec& m = sample < 2 ? ref : setup->methods[sample - 2];
+        const double dt = sample < 2 ? options.reference_dt : options.dt;
+        const std::uint64_t index = r + (sample == 1 ? kSampleB : 0);
+        return run_single(*setup, m, mix(options.seed, index), dt, options.time_limit);
+      },
+      [](MethodResult& mr, const DropRun& d) { mr.drops.push_back(d); });
   for (std::size_t i = 0; i < setup->methods.size(); ++i) {
     res.methods[i].name = setup->methods[i].name;
     res.methods[i].description = setup->methods[i].description;
@@ -818,24 +832,15 @@ FidelityResult run_fidelity(const FidelityOptions& options)
 
   if (options.piles) {
     const std::size_t seeds = static_cast<std::size_t>(options.pile_seeds);
-    Progress progress("fidelity: piles", samples * seeds, options.progress);
-    const std::vector<PileRun> all = parallel_map(
-        samples * seeds,
-        [&](std::size_t job) {
-          const std::size_t sample = job % samples, k = job / samples;
+    run_samples(
+        "fidelity: piles", samples, seeds, threads, options.progress, res,
+        [&](std::size_t sample, std::size_t k) {
           const MethodSpec& m = sample < 2 ? pile_ref : setup->methods[sample - 2];
           const double dt = sample < 2 ? options.pile_reference_dt : options.dt;
           const std::uint64_t seed = 1 + k + (sample == 1 ? seeds : 0);
-          PileRun p = run_pile(*setup, m, seed, options.pile_count, dt, options.time_limit, mix(options.seed, seed));
-          progress.add();
-          return p;
+          return run_pile(*setup, m, seed, options.pile_count, dt, options.time_limit, mix(options.seed, seed));
         },
-        threads);
-    for (std::size_t job = 0; job < all.size(); ++job) {
-      const std::size_t sample = job % samples;
-      MethodResult& mr = sample == 0 ? res.reference : sample == 1 ? res.reference_b : res.methods[sample - 2];
-      mr.piles.push_back(all[job]);
-    }
+        [](MethodResult& mr, const PileRun& p) { mr.piles.push_back(p); });
   }
 
   {

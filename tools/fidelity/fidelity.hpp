@@ -45,7 +45,6 @@ struct FidelityOptions {
   unsigned threads = 0;              ///< 0: every core
   int bootstrap = 200;               ///< resamples per interval
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes
-  bool allow_synthetic = false;      ///< box/lshape/bunny without a generated table: synthetic cube
   bool progress = true;
 };
 

@@ -117,7 +117,6 @@ std::string command_line(const FidelityOptions& o)
   if (o.timing) c << " --bench-n " << o.bench_n << " --bench-steps " << o.bench_steps;
   else c << " --no-timing";
   c << " --seed " << o.seed << " --bootstrap " << o.bootstrap;
-  if (o.allow_synthetic) c << " --allow-synthetic";
   return c.str();
 }
 
@@ -325,7 +324,6 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--threads", opts->threads, "worker threads (0: every core); results do not depend on it")
       ->capture_default_str();
   cmd->add_option("--meshes", opts->meshes_dir, "directory of the meshes (default: the source tree's tools/meshes)");
-  cmd->add_flag("--allow-synthetic", opts->allow_synthetic, "use the synthetic cube table if the shape has none");
   cmd->add_option("--json", *json_path, "write the results as JSON");
   cmd->add_option("--chart", *chart_path,
                   "FILE.png (and FILE.svg): summary error against time per step (log x), Pareto front, noise floor");

@@ -55,23 +55,39 @@ double tvd(const std::vector<double>& a, const std::vector<double>& b)
   return 0.5 * d;
 }
 
+namespace {
+
+/// Calls step(x, fa, fb) at each jump point x of the empirical CDFs of `a` and `b` (sorted, not
+/// empty), in increasing order, with fa and fb the two CDFs just after x.
+template <class Step>
+void walk_cdfs(const std::vector<double>& a, const std::vector<double>& b, Step step)
+{
+  const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
+  std::size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    const double x = j >= b.size() || (i < a.size() && a[i] <= b[j]) ? a[i] : b[j];
+    while (i < a.size() && a[i] == x) ++i;
+    while (j < b.size() && b[j] == x) ++j;
+    step(x, static_cast<double>(i) / na, static_cast<double>(j) / nb);
+  }
+}
+
+}  // namespace
+
 double w1(std::vector<double> a, std::vector<double> b)
 {
   if (a.empty() || b.empty()) return 0.0;
   std::sort(a.begin(), a.end());
   std::sort(b.begin(), b.end());
-  // Walk the merged jump points; between consecutive ones both CDFs are constant.
-  const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
-  std::size_t i = 0, j = 0;
-  double x = std::min(a[0], b[0]);
+  // Between consecutive jump points both CDFs are constant.
+  double x0 = std::min(a[0], b[0]), fa0 = 0, fb0 = 0;
   double d = 0;
-  while (i < a.size() || j < b.size()) {
-    const double next = j >= b.size() || (i < a.size() && a[i] <= b[j]) ? a[i] : b[j];
-    d += std::fabs(static_cast<double>(i) / na - static_cast<double>(j) / nb) * (next - x);
-    x = next;
-    while (i < a.size() && a[i] == x) ++i;
-    while (j < b.size() && b[j] == x) ++j;
-  }
+  walk_cdfs(a, b, [&](double x, double fa, double fb) {
+    d += std::fabs(fa0 - fb0) * (x - x0);
+    x0 = x;
+    fa0 = fa;
+    fb0 = fb;
+  });
   return d;
 }
 
@@ -80,15 +96,8 @@ double ks(std::vector<double> a, std::vector<double> b)
   if (a.empty() || b.empty()) return 0.0;
   std::sort(a.begin(), a.end());
   std::sort(b.begin(), b.end());
-  const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
-  std::size_t i = 0, j = 0;
   double d = 0;
-  while (i < a.size() || j < b.size()) {
-    const double x = j >= b.size() || (i < a.size() && a[i] <= b[j]) ? a[i] : b[j];
-    while (i < a.size() && a[i] == x) ++i;
-    while (j < b.size() && b[j] == x) ++j;
-    d = std::max(d, std::fabs(static_cast<double>(i) / na - static_cast<double>(j) / nb));
-  }
+  walk_cdfs(a, b, [&](double, double fa, double fb) { d = std::max(d, std::fabs(fa - fb)); });
   return d;
 }
 

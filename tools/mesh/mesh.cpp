@@ -584,16 +584,8 @@ bool parse_obj(const std::string& text, const std::string& name, TriMesh& mesh, 
 
 bool load_obj(const std::string& path, TriMesh& mesh, MeshError& error)
 {
-  try {
-    std::string text;
-    if (!read_file(path, text, error)) return false;
-    return parse_obj_impl(text, path, mesh, error);
-  } catch (const std::exception& e) {
-    error.message = path + ": " + e.what();
-  } catch (...) {
-    error.message = path + ": unknown error while reading the mesh";
-  }
-  return false;
+  std::string text;
+  return read_file(path, text, error) && parse_obj(text, path, mesh, error);
 }
 
 bool validate_mesh(const TriMesh& mesh, const std::string& name, MeshError& error, const std::vector<int>* face_lines)

@@ -8,7 +8,6 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -24,27 +23,17 @@ struct Fig3Command {
 
 void run_fig3_command(const Fig3Command& cmd)
 {
-  try {
-    Fig3Options options = cmd.options;
-    options.progress = true;
-    validate_fig3_options(options);      // fail before creating anything
-    ensure_writable_directory(cmd.out);  // and before the run, not after it
-    plot::find_python();                 // so is a missing matplotlib
-    const Fig3Result result = run_fig3(options);
-    write_fig3_outputs(result, cmd.out);
-    std::fputs(fig3_summary(result).c_str(), stdout);
-    std::printf("wrote %s, %s and %s\n", (cmd.out / "fig3.csv").c_str(), (cmd.out / "fig3.png").c_str(),
-                (cmd.out / "fig3.svg").c_str());
-    std::fflush(stdout);
-  } catch (const std::exception& e) {
-    std::string message = e.what();
-    if (message.rfind("fig3: ", 0) == 0) {
-      message.erase(0, 6);
-    }
-    std::fprintf(stderr, "statsim fig3: error: %s\n", message.c_str());
-    // CLI11_PARSE returns this exit code without printing anything more.
-    throw CLI::RuntimeError(1);
-  }
+  Fig3Options options = cmd.options;
+  options.progress = true;
+  validate_fig3_options(options);      // fail before creating anything
+  ensure_writable_directory(cmd.out);  // and before the run, not after it
+  plot::find_python();                 // so is a missing matplotlib
+  const Fig3Result result = run_fig3(options);
+  write_fig3_outputs(result, cmd.out);
+  std::fputs(fig3_summary(result).c_str(), stdout);
+  std::printf("wrote %s, %s and %s\n", (cmd.out / "fig3.csv").c_str(), (cmd.out / "fig3.png").c_str(),
+              (cmd.out / "fig3.svg").c_str());
+  std::fflush(stdout);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 #include "ref3d/model.hpp"
 
 #include "mesh/shapes.hpp"
-#include "ref3d/bullet.hpp"
+#include "bullet/bullet.hpp"
 
 #include <algorithm>
 #include <cmath>

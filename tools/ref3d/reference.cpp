@@ -1,6 +1,6 @@
 #include "ref3d/reference.hpp"
 
-#include "ref3d/bullet.hpp"
+#include "bullet/bullet.hpp"
 
 #include <cmath>
 #include <limits>
@@ -16,18 +16,13 @@ std::string bullet_version()
 
 namespace {
 
-btVector3 bt(const Eigen::Vector3d& v)
-{
-  return btVector3(v.x(), v.y(), v.z());
-}
-Eigen::Vector3d eig(const btVector3& v)
-{
-  return Eigen::Vector3d(v.x(), v.y(), v.z());
-}
-btTransform bt(const RigidState& s)
+using bullet::to_bt;
+using bullet::to_eigen;
+
+btTransform to_bt(const RigidState& s)
 {
   return btTransform(btQuaternion(s.orientation.x(), s.orientation.y(), s.orientation.z(), s.orientation.w()),
-                     bt(s.position));
+                     to_bt(s.position));
 }
 
 }  // namespace
@@ -92,7 +87,7 @@ struct Reference::Impl {
     w->world.addRigidBody(w->ground.get());
 
     btRigidBody::btRigidBodyConstructionInfo bi(mass, nullptr, body_shape.get(), local_inertia);
-    bi.m_startWorldTransform = bt(start);
+    bi.m_startWorldTransform = to_bt(start);
     bi.m_restitution = s.restitution;
     bi.m_friction = s.friction;
     bi.m_rollingFriction = rolling_friction;
@@ -107,8 +102,8 @@ struct Reference::Impl {
     // step before the touch, and the touch then sees a slower approach: restitution is lost.
     // Process only touching or penetrating points.
     if (!s.speculative_contacts) w->body->setContactProcessingThreshold(0.0);
-    w->body->setLinearVelocity(bt(start.velocity));
-    w->body->setAngularVelocity(bt(start.spin));
+    w->body->setLinearVelocity(to_bt(start.velocity));
+    w->body->setAngularVelocity(to_bt(start.spin));
     w->world.addRigidBody(w->body.get());
     return w;
   }
@@ -122,7 +117,7 @@ Reference::Reference(const ShapeModel& model, const ReferenceSettings& settings)
   if (settings.multipoint_plane) m.config.setPlaneConvexMultipointIterations(3, 3);
   const double margin = settings.margin;
   auto make_box = [&](const BodyBox& b) {
-    auto box = std::make_unique<btBoxShape>(bt(b.half_extents));
+    auto box = std::make_unique<btBoxShape>(to_bt(b.half_extents));
     box->setMargin(margin);  // btBoxShape keeps its outer size: the margin is inside the extents
     return box;
   };
@@ -143,7 +138,7 @@ Reference::Reference(const ShapeModel& model, const ReferenceSettings& settings)
         auto child = make_box(b);
         btMatrix3x3 basis(b.rotation(0, 0), b.rotation(0, 1), b.rotation(0, 2), b.rotation(1, 0), b.rotation(1, 1),
                           b.rotation(1, 2), b.rotation(2, 0), b.rotation(2, 1), b.rotation(2, 2));
-        compound->addChildShape(btTransform(basis, bt(b.centre)), child.get());
+        compound->addChildShape(btTransform(basis, to_bt(b.centre)), child.get());
         m.children.push_back(std::move(child));
       }
       compound->setMargin(margin);
@@ -153,7 +148,7 @@ Reference::Reference(const ShapeModel& model, const ReferenceSettings& settings)
     case ShapeKind::mesh: {
       if (settings.mesh_hull) {
         auto hull = std::make_unique<btConvexHullShape>();
-        for (const auto& p : model.hull) hull->addPoint(bt(p), false);
+        for (const auto& p : model.hull) hull->addPoint(to_bt(p), false);
         hull->recalcLocalAabb();
         hull->setMargin(margin);
         m.body_shape = std::move(hull);
@@ -178,7 +173,7 @@ Reference::Reference(const ShapeModel& model, const ReferenceSettings& settings)
     m.ground_shape = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0.0);
   }
   m.mass = model.mass.mass;
-  m.local_inertia = bt(model.mass.principal_moments);
+  m.local_inertia = to_bt(model.mass.principal_moments);
 }
 
 Reference::~Reference() = default;
@@ -189,11 +184,11 @@ RigidState state_of(const btRigidBody& body)
 {
   RigidState s;
   const btTransform& t = body.getCenterOfMassTransform();
-  s.position = eig(t.getOrigin());
+  s.position = to_eigen(t.getOrigin());
   const btQuaternion q = t.getRotation();
   s.orientation = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized();
-  s.velocity = eig(body.getLinearVelocity());
-  s.spin = eig(body.getAngularVelocity());
+  s.velocity = to_eigen(body.getLinearVelocity());
+  s.spin = to_eigen(body.getAngularVelocity());
   return s;
 }
 

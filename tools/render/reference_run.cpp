@@ -1,14 +1,13 @@
-// Bullet's side uses the settings of `statsim bench` (tools/bench/bench_bullet.cpp, read there for
-// the reasons): margin 0.002 m, sqrt of the table's restitution and friction on every body and the
-// ground (Bullet multiplies the two), statsim's restitution threshold and sleep thresholds, the
-// full mesh's principal moments scaled to the table's mass, btDbvtBroadphase, the sequential
-// impulse solver with its defaults. One difference: 4 internal steps of 1/240 s per 1/60 s frame,
-// since this run is the picture of the truth (GImpact at 1/60 s lets fast bunnies sink).
+// Bullet's side is tools/bullet's drop world with the settings of `statsim bench` (the reasons are
+// in tools/bench/bench_bullet.cpp): the table's material, statsim's restitution threshold and sleep
+// thresholds, the full mesh's principal moments scaled to the table's mass, btDbvtBroadphase.
+// Differences: AABBs of sleeping bodies are updated (Bullet's default), and every 1/60 s frame is
+// 4 internal steps, since this run is the picture of the truth.
 #include "render/reference_run.hpp"
 
 #include "mesh/mass.hpp"
 #include "mesh/mesh.hpp"
-#include "ref3d/bullet.hpp"
+#include "bullet/drop_world.hpp"
 #include "render/frames.hpp"
 #include "scenes/scenes.hpp"
 #include "statsim/world3.hpp"
@@ -24,6 +23,8 @@ namespace statsim::tools::render {
 namespace {
 
 constexpr std::uint32_t kCapacity = 4096;
+// Bullet steps a frame in this many internal steps: GImpact at 1/60 s lets fast bunnies sink.
+constexpr int kSubsteps = 4;
 World3<kCapacity> g_world;  // large: kept out of the stack
 
 struct Written {
@@ -116,72 +117,40 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
     return true;
   }
 
-  // Bullet: the full bunny mesh as one shared btGImpactMeshShape.
-  std::vector<btScalar> vertices;
+  // Bullet: the full bunny mesh as one shared GImpact shape, the table's material and the statsim
+  // world's thresholds.
   std::vector<int> indices;
-  for (const Eigen::Vector3d& v : mesh.vertices) vertices.insert(vertices.end(), {v.x(), v.y(), v.z()});
   for (const auto& t : mesh.triangles) indices.insert(indices.end(), {t[0], t[1], t[2]});
-  btTriangleIndexVertexArray array(int(mesh.triangles.size()), indices.data(), int(3 * sizeof(int)),
-                                   int(mesh.vertices.size()), vertices.data(), int(3 * sizeof(btScalar)));
-  btGImpactMeshShape shape(&array);
-  shape.setMargin(0.002);
-  shape.updateBound();
-  btStaticPlaneShape ground_shape(btVector3(0, 0, 1), 0);
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher(&config);
-  btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
-  world.setGravity(btVector3(0, 0, -9.81));
-  world.getSolverInfo().m_restitutionVelocityThreshold = double(defaults.restitution_threshold);
-  gDeactivationTime = double(defaults.sleep_time);
-  const double friction = std::sqrt(double(sig.material.friction));
-  const double restitution = std::sqrt(double(sig.material.restitution));
-  btRigidBody::btRigidBodyConstructionInfo ground_info(0, nullptr, &ground_shape);
-  ground_info.m_friction = friction;
-  ground_info.m_restitution = restitution;
-  btRigidBody ground(ground_info);
-  world.addRigidBody(&ground);
+  bullet::Shapes shapes;
+  bullet::DropBody body;
+  body.shape = shapes.mesh(mesh.vertices, indices);
+  body.mass = double(sig.mass);
   const double scale = double(sig.mass) / mp.mass;
-  const btVector3 inertia(mp.principal_moments.x() * scale, mp.principal_moments.y() * scale,
-                          mp.principal_moments.z() * scale);
-  std::vector<std::unique_ptr<btRigidBody>> bodies;
-  for (const scenes::BodyState3& s : scene.bodies) {
-    btRigidBody::btRigidBodyConstructionInfo info(double(sig.mass), nullptr, &shape, inertia);
-    info.m_friction = friction;
-    info.m_restitution = restitution;
-    info.m_linearSleepingThreshold = double(defaults.sleep_speed);
-    info.m_angularSleepingThreshold = double(defaults.sleep_speed) / mp.bounding_radius;
-    const Eigen::Quaterniond& q = s.orientation;
-    info.m_startWorldTransform = btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()),
-                                             btVector3(s.position.x(), s.position.y(), s.position.z()));
-    bodies.push_back(std::make_unique<btRigidBody>(info));
-    bodies.back()->setLinearVelocity(btVector3(s.linear_velocity.x(), s.linear_velocity.y(), s.linear_velocity.z()));
-    bodies.back()->setAngularVelocity(
-        btVector3(s.angular_velocity.x(), s.angular_velocity.y(), s.angular_velocity.z()));
-    world.addRigidBody(bodies.back().get());
-  }
+  body.inertia = Eigen::Vector3d(mp.principal_moments.x() * scale, mp.principal_moments.y() * scale,
+                                 mp.principal_moments.z() * scale);
+  body.bounding_radius = mp.bounding_radius;
+  bullet::DropSettings settings;
+  settings.restitution = double(sig.material.restitution);
+  settings.friction = double(sig.material.friction);
+  settings.restitution_threshold = double(defaults.restitution_threshold);
+  settings.sleep_speed = double(defaults.sleep_speed);
+  settings.sleep_time = double(defaults.sleep_time);
+  bullet::DropWorld world(body, scene.bodies, settings);
   std::size_t asleep = 0;
   for (int s = 0; s < steps; ++s) {
-    world.stepSimulation(dt, 4, dt / 4);
+    world.step(dt, kSubsteps);
     if (s % o.every != 0) continue;
     asleep = 0;
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      const btTransform& t = bodies[i]->getWorldTransform();
-      const btQuaternion q = t.getRotation();
-      const bool sleeping = bodies[i]->getActivationState() == ISLAND_SLEEPING;
+    for (std::size_t i = 0; i < world.size(); ++i) {
+      const scenes::BodyState3 b = world.state(i);
+      const bool sleeping = world.asleep(i);
       asleep += sleeping ? 1 : 0;
-      write_frame_row(out.f, s, double(s + 1) * dt, int(i), "bunny",
-                      Eigen::Vector3d(t.getOrigin().x(), t.getOrigin().y(), t.getOrigin().z()),
-                      Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()), sleeping ? 2 : 0, 0.0);
+      write_frame_row(out.f, s, double(s + 1) * dt, int(i), "bunny", b.position, b.orientation, sleeping ? 2 : 0, 0.0);
     }
   }
-  for (auto& b : bodies) world.removeRigidBody(b.get());
-  world.removeRigidBody(&ground);
   std::printf("reference-run: %s, Bullet (full bunny mesh, GImpact), %d steps of 1/60 s (4 substeps), %zu of %zu "
               "asleep at the last written frame -> %s\n",
-              o.scene.c_str(), steps, asleep, bodies.size(), o.frames.c_str());
+              o.scene.c_str(), steps, asleep, world.size(), o.frames.c_str());
   return true;
 }
 

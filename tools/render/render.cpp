@@ -18,6 +18,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 #ifndef STATSIM_RENDER_MESHES_DIR
 #define STATSIM_RENDER_MESHES_DIR "tools/meshes"
@@ -128,6 +129,24 @@ bool load_render_shape(const std::string& name, const std::string& meshes_dir, R
     return false;
   }
   for (const Eigen::Vector3f& v : shape.vertices) shape.bounding_radius = std::max(shape.bounding_radius, double(v.norm()));
+  return true;
+}
+
+bool load_frames(const std::string& path, const std::string& shape_names, const std::string& detail,
+                 const std::string& meshes_dir, LoadedFrames& out, std::string& error)
+{
+  std::vector<std::string> names;
+  std::stringstream list(shape_names);
+  for (std::string item; std::getline(list, item, ',');) names.push_back(item);
+  if (!read_frames(path, names, out.frames, error)) return false;
+  const int bodies = out.frames.body_count();
+  for (const std::string& name : out.frames.shapes) {
+    const bool low = name == "bunny" && (detail == "low" || (detail == "auto" && bodies > 1000));
+    auto s = std::make_unique<RenderShape>();
+    if (!load_render_shape(low ? "bunny_low" : name, meshes_dir, *s, error)) return false;
+    out.shapes.push_back(s.get());
+    out.owned.push_back(std::move(s));
+  }
   return true;
 }
 
@@ -318,6 +337,17 @@ struct ScreenBox {
   bool visible = false;
 };
 
+/// The pixels to visit for `box` in the band of rows y0 .. y1 of an image `w` pixels wide: from
+/// x0 to x1 and y0 to y1, inclusive (empty when a start is past its end).
+struct PixelSpan {
+  int x0, x1, y0, y1;
+};
+PixelSpan pixel_span(const ScreenBox& box, int y0, int y1, int w)
+{
+  return {int(std::clamp(box.x0, 0.0, double(w))), int(std::clamp(box.x1 + 1, -1.0, double(w - 1))),
+          int(std::clamp(box.y0, double(y0), double(y1))), int(std::clamp(box.y1 + 1, double(y0 - 1), double(y1 - 1)))};
+}
+
 }  // namespace
 
 Image render_frame(const Frame& frame, const std::vector<const RenderShape*>& shapes, const Camera& camera,
@@ -446,12 +476,9 @@ Image render_frame(const Frame& frame, const std::vector<const RenderShape*>& sh
           const RenderShape& s = *shapes[std::size_t(b.shape)];
           const double r = 0.8 * s.bounding_radius * body_scale(s, b);
           const double strength = 0.45 * std::max(0.0, 1.0 - std::max(0.0, b.position.z() - r) / (3 * r));
-          const int sy0 = int(std::clamp(box.y0, double(y0), double(y1)));
-          const int sy1 = int(std::clamp(box.y1 + 1, double(y0 - 1), double(y1 - 1)));
-          const int sx0 = int(std::clamp(box.x0, 0.0, double(W)));
-          const int sx1 = int(std::clamp(box.x1 + 1, -1.0, double(W - 1)));
-          for (int y = sy0; y <= sy1; ++y)
-            for (int x = sx0; x <= sx1; ++x) {
+          const PixelSpan span = pixel_span(box, y0, y1, W);
+          for (int y = span.y0; y <= span.y1; ++y)
+            for (int x = span.x0; x <= span.x1; ++x) {
               const std::size_t p = std::size_t(y) * std::size_t(W) + std::size_t(x);
               if (!(depth[p] > 0)) continue;
               Eigen::Vector3d o, d;
@@ -530,12 +557,9 @@ Image render_frame(const Frame& frame, const std::vector<const RenderShape*>& sh
           const RenderShape& s = *shapes[std::size_t(b.shape)];
           const double r = b.radius > 0 ? b.radius : s.table_sphere_radius;
           if (!(r > 0)) continue;
-          const int sy0 = int(std::clamp(box.y0, double(y0), double(y1)));
-          const int sy1 = int(std::clamp(box.y1 + 1, double(y0 - 1), double(y1 - 1)));
-          const int sx0 = int(std::clamp(box.x0, 0.0, double(W)));
-          const int sx1 = int(std::clamp(box.x1 + 1, -1.0, double(W - 1)));
-          for (int y = sy0; y <= sy1; ++y)
-            for (int x = sx0; x <= sx1; ++x) {
+          const PixelSpan span = pixel_span(box, y0, y1, W);
+          for (int y = span.y0; y <= span.y1; ++y)
+            for (int x = span.x0; x <= span.x1; ++x) {
               Eigen::Vector3d o, d;
               pj.ray(x + 0.5, y + 0.5, o, d);
               const Eigen::Vector3d oc = o - b.position;

@@ -28,6 +28,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,19 @@ bool load_render_shape(const std::string& name, const std::string& meshes_dir, R
 
 /// The directory of the committed meshes (tools/meshes of the source tree).
 std::string default_meshes_dir();
+
+/// A frame file and the shapes its bodies are drawn with (shapes[i] is shape index i).
+struct LoadedFrames {
+  Frames frames;
+  std::vector<std::unique_ptr<RenderShape>> owned;
+  std::vector<const RenderShape*> shapes;
+};
+
+/// Reads the frame file `path` (`shape_names`: names of numeric shape ids, comma-separated) and
+/// loads its shapes from `meshes_dir`. `detail` picks the bunny's mesh: "full", "low" (bunny_low)
+/// or "auto" (low above 1,000 bodies). Returns false with `error` set.
+bool load_frames(const std::string& path, const std::string& shape_names, const std::string& detail,
+                 const std::string& meshes_dir, LoadedFrames& out, std::string& error);
 
 struct Camera {
   Eigen::Vector3d eye = Eigen::Vector3d(3, -3, 2);
@@ -115,3 +129,12 @@ bool write_gif(const std::string& path, const std::vector<Image>& images, int de
 Eigen::Vector3f body_colour(int index);
 
 }  // namespace statsim::tools::render
+
+namespace CLI {
+class App;
+}
+
+namespace statsim::tools {
+/// Adds `statsim render` (PNG frames, GIF, side by side) and `statsim reference-run`.
+void register_render_commands(CLI::App& app);
+}  // namespace statsim::tools

@@ -1,9 +1,8 @@
-#include "render/render_commands.hpp"
+#include "render/render.hpp"
 
 #include "common/progress.hpp"
 #include "render/frames.hpp"
 #include "render/reference_run.hpp"
-#include "render/render.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -82,32 +81,12 @@ void optimise_gif(const std::string& path)
                                ec);
 }
 
-struct Loaded {
-  render::Frames frames;
-  std::vector<std::unique_ptr<render::RenderShape>> owned;
-  std::vector<const render::RenderShape*> shapes;
-};
-
-bool load(const std::string& path, const RenderArgs& a, Loaded& l)
+bool load(const std::string& path, const RenderArgs& a, render::LoadedFrames& l)
 {
   std::string error;
-  if (!render::read_frames(path, split_list(a.shapes), l.frames, error)) {
-    std::fprintf(stderr, "render: %s\n", error.c_str());
-    return false;
-  }
-  const int bodies = l.frames.body_count();
-  for (const std::string& name : l.frames.shapes) {
-    std::string mesh = name;
-    if (name == "bunny" && (a.detail == "low" || (a.detail == "auto" && bodies > 1000))) mesh = "bunny_low";
-    auto s = std::make_unique<render::RenderShape>();
-    if (!render::load_render_shape(mesh, a.meshes, *s, error)) {
-      std::fprintf(stderr, "render: %s\n", error.c_str());
-      return false;
-    }
-    l.shapes.push_back(s.get());
-    l.owned.push_back(std::move(s));
-  }
-  return true;
+  if (render::load_frames(path, a.shapes, a.detail, a.meshes, l, error)) return true;
+  std::fprintf(stderr, "render: %s\n", error.c_str());
+  return false;
 }
 
 std::vector<std::size_t> select(const render::Frames& f, const RenderArgs& a)
@@ -135,13 +114,13 @@ int run_render(const RenderArgs& a)
     std::fprintf(stderr, "render: give --out DIR (or FILE.png for one frame) and/or --gif FILE\n");
     return 2;
   }
-  std::vector<Loaded> runs(a.side.empty() ? 1 : 2);
+  std::vector<render::LoadedFrames> runs(a.side.empty() ? 1 : 2);
   if (!load(a.in, a, runs[0])) return 1;
   if (!a.side.empty() && !load(a.side, a, runs[1])) return 1;
 
   // Keep only the selected frames: the camera frames exactly what is drawn.
   std::vector<std::vector<std::size_t>> picks;
-  for (Loaded& l : runs) {
+  for (render::LoadedFrames& l : runs) {
     const std::vector<std::size_t> pick = select(l.frames, a);
     render::Frames kept = l.frames;
     kept.frames.clear();
@@ -159,7 +138,7 @@ int run_render(const RenderArgs& a)
 
   std::vector<const render::Frames*> all;
   std::vector<std::vector<const render::RenderShape*>> all_shapes;
-  for (const Loaded& l : runs) {
+  for (const render::LoadedFrames& l : runs) {
     all.push_back(&l.frames);
     all_shapes.push_back(l.shapes);
   }
@@ -209,7 +188,7 @@ int run_render(const RenderArgs& a)
   for (std::size_t k = 0; k < count; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<render::Image> panels;
-    for (const Loaded& l : runs) {
+    for (const render::LoadedFrames& l : runs) {
       const render::Frame& f = l.frames.frames[std::min(k, l.frames.frames.size() - 1)];
       panels.push_back(render::render_frame(f, l.shapes, camera, ro));
     }

@@ -1,13 +1,17 @@
 // The `statsim` host command: one executable, one subcommand per job.
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+#include <exception>
+#include <string>
+
 #include "bench/bench.hpp"
-#include "export/export_commands.hpp"
+#include "export/gltf_export.hpp"
 #include "fidelity/fidelity.hpp"
 #include "mesh/mesh_commands.hpp"
 #include "ref2d/ref2d.hpp"
 #include "ref3d/ref3d.hpp"
-#include "render/render_commands.hpp"
+#include "render/render.hpp"
 #include "stress/stress.hpp"
 
 int main(int argc, char** argv)
@@ -23,6 +27,18 @@ int main(int argc, char** argv)
   statsim::tools::register_export_commands(app);
   statsim::tools::register_stress_commands(app);
   statsim::tools::fidelity::register_fidelity_commands(app);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    // A subcommand failed (bad options, unreadable input, unwritable output): one line that names
+    // it, and exit code 1.
+    const std::string name = app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name();
+    std::string message = e.what();
+    if (!name.empty() && message.rfind(name + ": ", 0) == 0) message.erase(0, name.size() + 2);
+    std::fprintf(stderr, "statsim %s: error: %s\n", name.c_str(), message.c_str());
+    return 1;
+  }
   return 0;
 }

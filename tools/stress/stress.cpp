@@ -1,17 +1,15 @@
 // `statsim stress`: see stress.hpp. Every scene is built from fixed seeds, so a run is
 // repeatable; wall-clock figures (ms per step) are the only ones that vary between runs.
 //
-// Methods. 3D: full, low, spheres7, sphere = Bullet 3.24 (double precision) with the benchmark's
-// representations of the bunny (btGImpactMeshShape of the full and the ~100-vertex mesh, a
-// compound of 7 spheres, one sphere of the table's zero-spin collision radius), margins 2 mm,
-// material and sleeping thresholds of the statistical table, stepSimulation(dt, 0), no CCD;
-// statistical = statsim World3 with tables/bunny.hpp and the runtime's defaults.
+// Methods. 3D: full, low, spheres7, sphere = the benchmark's Bullet simulator (tools/bench: its
+// representations of the bunny and its settings, with the scene's planes, gravity and material,
+// and btDbvtBroadphase); statistical = statsim World3 with tables/bunny.hpp and the runtime's
+// defaults.
 // 2D: polygon = Box2D 2.4.1 unit square (velocity 8, position 3 iterations, its default CCD);
 // statistical2d = statsim World2 with tables/square2d.hpp.
 #include "stress/stress.hpp"
 
 #include "bench/bench_internal.hpp"
-#include "bench/bullet.hpp"
 #include "scenes/scenes.hpp"
 
 #include "statsim/world2.hpp"
@@ -68,54 +66,18 @@ bool finite3(const Eigen::Vector3d& v)
   return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
 }
 
-/// Plane n.x = offset (n unit), the solid side where n.x > offset.
-struct PlaneSpec {
-  Eigen::Vector3d normal;
-  double offset;
-};
-
-/// Per-body state every 3D method reports.
-struct State3 {
-  Eigen::Vector3d x, v, w;
-  Eigen::Quaterniond q;
-  double radius = 0;  ///< statsim's current collision radius; 0 for Bullet
-  bool asleep = false;
-};
-
-/// Lowest point of a representation below its centre, for orientation q: min over its geometry of
-/// (R p).z (negative).
-double lowest_offset(const Body3& body, const std::string& method, const Eigen::Quaterniond& q)
+/// The largest of `vmax` and the speeds of the bodies now; infinite once one is not finite.
+double max_speed(const bench::Sim& sim, double vmax)
 {
-  const Eigen::Matrix3d r = q.toRotationMatrix();
-  double lo = kInf;
-  if (method == "full" || method == "low") {
-    const auto& vs = method == "full" ? body.full_vertices : body.low_vertices;
-    for (const auto& p : vs) lo = std::min(lo, r.row(2).dot(p));
-  } else if (method == "spheres7") {
-    for (const auto& s : body.spheres) lo = std::min(lo, r.row(2).dot(s.head<3>()) - s[3]);
-  } else {
-    lo = -body.sphere_radius;
+  for (std::size_t i = 0; i < sim.body_count(); ++i) {
+    const double v = sim.body_state(i).linear_velocity.norm();
+    vmax = std::isfinite(v) ? std::max(vmax, v) : kInf;
   }
-  return lo;
+  return vmax;
 }
 
-// ---- a 3D world of any method ---------------------------------------------------------------------
-class Sim3 {
-public:
-  virtual ~Sim3() = default;
-  virtual void step(double dt) = 0;
-  virtual std::size_t size() const = 0;
-  virtual State3 state(std::size_t i) const = 0;
-  virtual double kinetic_energy() const = 0;
-  /// Deepest overlap now: statsim between collision spheres (fraction of their radius sum);
-  /// Bullet the deepest contact point of any manifold (m).
-  virtual double overlap() const = 0;
-  /// Height of the lowest point of body i above z = 0 (negative: below the ground).
-  virtual double lowest(std::size_t i) const = 0;
-};
-
 struct Setup3 {
-  std::vector<PlaneSpec> planes{{Eigen::Vector3d(0, 0, 1), 0.0}};
+  std::vector<bullet::Plane> planes{{Eigen::Vector3d(0, 0, 1), 0.0}};
   Eigen::Vector3d gravity{0, 0, -kG};
   /// Bullet material; statsim uses the table's (or `particle`'s).
   double restitution = -1, friction = -1;  // < 0: the table's
@@ -125,172 +87,15 @@ struct Setup3 {
   bool particle = false;
 };
 
-// Bullet ------------------------------------------------------------------------------------------
-btVector3 bt(const Eigen::Vector3d& v)
-{
-  return btVector3(v.x(), v.y(), v.z());
-}
-Eigen::Vector3d eig(const btVector3& v)
-{
-  return Eigen::Vector3d(v.x(), v.y(), v.z());
-}
-
-class BulletSim3 final : public Sim3 {
-public:
-  BulletSim3(const Body3& body, const std::string& method, const Setup3& setup,
-             const std::vector<scenes::BodyState3>& states)
-      : body_(body), method_(method)
-  {
-    const int n = static_cast<int>(states.size());
-    btDefaultCollisionConstructionInfo cci;
-    cci.m_defaultMaxPersistentManifoldPoolSize = std::max(4096, 4 * n);
-    cci.m_defaultMaxCollisionAlgorithmPoolSize = std::max(4096, 4 * n);
-    config_ = std::make_unique<btDefaultCollisionConfiguration>(cci);
-    dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
-    btGImpactCollisionAlgorithm::registerAlgorithm(dispatcher_.get());
-    broadphase_ = std::make_unique<btDbvtBroadphase>();
-    solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-    world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
-                                                       config_.get());
-    world_->setGravity(bt(setup.gravity));
-    world_->getSolverInfo().m_restitutionVelocityThreshold = body.surface.restitution_threshold;
-    gDeactivationTime = body.surface.sleep_time;
-    make_shape();
-    const double e = setup.restitution >= 0 ? setup.restitution : body.surface.restitution;
-    const double mu = setup.friction >= 0 ? setup.friction : body.surface.friction;
-    // Bullet multiplies the two sides' coefficients: sqrt on each gives every contact e and mu.
-    const double se = std::sqrt(e), smu = std::sqrt(mu);
-    for (const PlaneSpec& p : setup.planes) {
-      planes_.push_back(std::make_unique<btStaticPlaneShape>(bt(p.normal), p.offset));
-      btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, planes_.back().get());
-      info.m_friction = smu;
-      info.m_restitution = se;
-      statics_.push_back(std::make_unique<btRigidBody>(info));
-      world_->addRigidBody(statics_.back().get());
-    }
-    const double rolling =
-        method == "sphere" && smu > 0 ? body.surface.rolling_resistance * body.sphere_radius / smu : 0.0;
-    inertia_ = body.inertia;
-    for (const scenes::BodyState3& s : states) {
-      btRigidBody::btRigidBodyConstructionInfo info(body.mass, nullptr, shape_, bt(body.inertia));
-      info.m_friction = smu;
-      info.m_restitution = se;
-      info.m_rollingFriction = setup.friction == 0 ? 0.0 : rolling;
-      info.m_linearSleepingThreshold = body.surface.sleep_speed;
-      info.m_angularSleepingThreshold = body.surface.sleep_speed / body.bounding_radius;
-      const Eigen::Quaterniond& q = s.orientation;
-      info.m_startWorldTransform = btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), bt(s.position));
-      auto rb = std::make_unique<btRigidBody>(info);
-      rb->setLinearVelocity(bt(s.linear_velocity));
-      rb->setAngularVelocity(bt(s.angular_velocity));
-      if (!setup.sleeping) rb->setActivationState(DISABLE_DEACTIVATION);
-      world_->addRigidBody(rb.get());
-      bodies_.push_back(std::move(rb));
-    }
-  }
-  ~BulletSim3() override { world_.reset(); }
-
-  void step(double dt) override { world_->stepSimulation(dt, 0); }
-  std::size_t size() const override { return bodies_.size(); }
-  State3 state(std::size_t i) const override
-  {
-    const btRigidBody& b = *bodies_[i];
-    State3 s;
-    s.x = eig(b.getCenterOfMassPosition());
-    s.v = eig(b.getLinearVelocity());
-    s.w = eig(b.getAngularVelocity());
-    const btQuaternion q = b.getOrientation();
-    s.q = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
-    s.asleep = b.getActivationState() == ISLAND_SLEEPING;
-    return s;
-  }
-  double kinetic_energy() const override
-  {
-    double ke = 0;
-    for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      const State3 s = state(i);
-      const Eigen::Vector3d wb = s.q.conjugate() * s.w;
-      ke += 0.5 * body_.mass * s.v.squaredNorm() + 0.5 * wb.dot(inertia_.cwiseProduct(wb));
-    }
-    return ke;
-  }
-  double overlap() const override
-  {
-    double deepest = 0;
-    btDispatcher* d = world_->getDispatcher();
-    for (int i = 0; i < d->getNumManifolds(); ++i) {
-      const btPersistentManifold* m = d->getManifoldByIndexInternal(i);
-      for (int k = 0; k < m->getNumContacts(); ++k)
-        deepest = std::max(deepest, -double(m->getContactPoint(k).getDistance()));
-    }
-    return deepest;
-  }
-  double lowest(std::size_t i) const override
-  {
-    const State3 s = state(i);
-    return s.x.z() + lowest_offset(body_, method_, s.q);
-  }
-
-private:
-  void make_shape()
-  {
-    if (method_ == "full" || method_ == "low") {
-      const auto& vs = method_ == "full" ? body_.full_vertices : body_.low_vertices;
-      indices_ = method_ == "full" ? body_.full_indices : body_.low_indices;
-      for (const auto& p : vs) vertices_.insert(vertices_.end(), {p.x(), p.y(), p.z()});
-      array_ = std::make_unique<btTriangleIndexVertexArray>(
-          static_cast<int>(indices_.size() / 3), indices_.data(), static_cast<int>(3 * sizeof(int)),
-          static_cast<int>(vs.size()), vertices_.data(), static_cast<int>(3 * sizeof(btScalar)));
-      auto mesh = std::make_unique<btGImpactMeshShape>(array_.get());
-      mesh->setMargin(0.002);
-      mesh->updateBound();
-      shape_ = mesh.get();
-      owned_ = std::move(mesh);
-    } else if (method_ == "spheres7") {
-      auto compound = std::make_unique<btCompoundShape>();
-      for (const auto& s : body_.spheres) {
-        children_.push_back(std::make_unique<btSphereShape>(s[3]));
-        btTransform t;
-        t.setIdentity();
-        t.setOrigin(btVector3(s[0], s[1], s[2]));
-        compound->addChildShape(t, children_.back().get());
-      }
-      shape_ = compound.get();
-      owned_ = std::move(compound);
-    } else {
-      auto sphere = std::make_unique<btSphereShape>(body_.sphere_radius);
-      shape_ = sphere.get();
-      owned_ = std::move(sphere);
-    }
-  }
-
-  const Body3& body_;
-  std::string method_;
-  Eigen::Vector3d inertia_;
-  std::vector<btScalar> vertices_;
-  std::vector<int> indices_;
-  std::unique_ptr<btTriangleIndexVertexArray> array_;
-  std::vector<std::unique_ptr<btSphereShape>> children_;
-  std::unique_ptr<btCollisionShape> owned_;
-  btCollisionShape* shape_ = nullptr;
-  std::unique_ptr<btDefaultCollisionConfiguration> config_;
-  std::unique_ptr<btCollisionDispatcher> dispatcher_;
-  std::unique_ptr<btBroadphaseInterface> broadphase_;
-  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
-  std::vector<std::unique_ptr<btStaticPlaneShape>> planes_;
-  std::vector<std::unique_ptr<btRigidBody>> statics_;
-  std::vector<std::unique_ptr<btRigidBody>> bodies_;
-  std::unique_ptr<btDiscreteDynamicsWorld> world_;  // destroyed first (declared last)
-};
-
-// statsim 3D --------------------------------------------------------------------------------------
+// statsim 3D: the benchmark's statsim world has one ground plane, gravity and the table's shape;
+// the stress scenes need walls, no gravity and the particle model.
 template <std::uint32_t Cap>
-class StatsimSim3 final : public Sim3 {
+class StatsimSim3 final : public bench::Sim {
 public:
   using WorldT = World3<Cap, 8, Cap * 32, 2>;
 
-  StatsimSim3(const Body3& body, const Setup3& setup, const std::vector<scenes::BodyState3>& states)
-      : sig_(tables::bunny.view()), particle_(setup.particle)
+  StatsimSim3(const Setup3& setup, const std::vector<scenes::BodyState3>& states, double dt)
+      : sig_(tables::bunny.view()), particle_(setup.particle), dt_(static_cast<Scalar>(dt))
   {
     if (states.size() > Cap) throw std::runtime_error("stress: statsim world too small");
     WorldDef3 def;
@@ -308,12 +113,11 @@ public:
       shape = world_->add_shape(sig_);
     }
     if (!shape.ok()) throw std::runtime_error(std::string("statsim add_shape: ") + to_string(shape.status));
-    for (const PlaneSpec& p : setup.planes) {
+    for (const bullet::Plane& p : setup.planes) {
       const auto added = world_->add_plane(p.normal.cast<Scalar>(), static_cast<Scalar>(p.offset));
       if (!added.ok()) throw std::runtime_error(std::string("statsim add_plane: ") + to_string(added.status));
     }
     mass_ = static_cast<double>(sig_.mass);
-    (void)body;
     for (const scenes::BodyState3& s : states) {
       BodyDef3 b;
       b.position = s.position.cast<Scalar>();
@@ -326,24 +130,37 @@ public:
       if (!added.ok()) throw std::runtime_error(std::string("statsim add_body: ") + to_string(added.status));
     }
   }
-  void step(double dt) override
+  void step() override
   {
-    last_ = world_->step(static_cast<Scalar>(dt));
+    last_ = world_->step(dt_);
     if (last_.status != Status::ok) throw std::runtime_error(std::string("statsim step: ") + to_string(last_.status));
     dropped_ = std::max(dropped_, last_.pairs_dropped);
   }
-  std::size_t size() const override { return world_->body_count(); }
-  State3 state(std::size_t i) const override
+  std::size_t asleep() const override { return world_->count(MotionState::asleep); }
+  bench::EndState end_state() const override
+  {
+    bench::EndState e;
+    e.asleep = asleep();
+    double h = 0;
+    for (std::uint32_t i = 0; i < world_->body_count(); ++i) h += double(world_->body(i).position.z());
+    e.mean_height = world_->body_count() ? h / world_->body_count() : 0.0;
+    e.contacts = last_.contacts;
+    return e;
+  }
+  std::size_t body_count() const override { return world_->body_count(); }
+  scenes::BodyState3 body_state(std::size_t i) const override
   {
     const Body<3>& b = world_->body(static_cast<BodyId>(i));
-    State3 s;
-    s.x = b.position.cast<double>();
-    s.v = b.linear_velocity.cast<double>();
-    s.w = b.angular_velocity.cast<double>();
-    s.q = b.orientation.cast<double>();
-    s.radius = double(b.radius);
-    s.asleep = b.state == MotionState::asleep;
+    scenes::BodyState3 s;
+    s.position = b.position.cast<double>();
+    s.orientation = b.orientation.cast<double>();
+    s.linear_velocity = b.linear_velocity.cast<double>();
+    s.angular_velocity = b.angular_velocity.cast<double>();
     return s;
+  }
+  bool body_asleep(std::size_t i) const override
+  {
+    return world_->body(static_cast<BodyId>(i)).state == MotionState::asleep;
   }
   double kinetic_energy() const override
   {
@@ -386,25 +203,37 @@ public:
   }
   std::uint32_t pairs_dropped() const { return dropped_; }
   std::uint64_t hash() const { return world_->state_hash(); }
-  const WorldT& world() const { return *world_; }
 
 private:
   SignatureView<3> sig_;
   bool particle_;
+  Scalar dt_;
   double mass_ = 1;
   std::unique_ptr<WorldT> world_;
   StepResult last_{};
   std::uint32_t dropped_ = 0;
 };
 
-std::unique_ptr<Sim3> make_sim3(const Body3& body, const std::string& method, const Setup3& setup,
-                                const std::vector<scenes::BodyState3>& states)
+/// A 3D world of `method` stepped by dt: Bullet through the benchmark's simulator (its settings,
+/// with the setup's planes, gravity, material and sleeping), statsim through StatsimSim3.
+std::unique_ptr<bench::Sim> make_sim3(const Body3& body, const std::shared_ptr<bench::BulletShapes>& shapes,
+                                      const std::string& method, const Setup3& setup,
+                                      const std::vector<scenes::BodyState3>& states, double dt)
 {
   if (method == "statistical") {
-    if (states.size() <= 1024) return std::make_unique<StatsimSim3<1024>>(body, setup, states);
-    return std::make_unique<StatsimSim3<16384>>(body, setup, states);
+    if (states.size() <= 1024) return std::make_unique<StatsimSim3<1024>>(setup, states, dt);
+    return std::make_unique<StatsimSim3<16384>>(setup, states, dt);
   }
-  return std::make_unique<BulletSim3>(body, method, setup, states);
+  bullet::DropSettings s = bench::bullet_drop_settings(body, method, "dbvt", scenes::DropScene3{});
+  s.planes = setup.planes;
+  s.gravity = setup.gravity;
+  if (setup.restitution >= 0) s.restitution = setup.restitution;
+  if (setup.friction >= 0) s.friction = setup.friction;
+  s.sleeping = setup.sleeping;
+  // Bullet's default, with which the stress figures have been recorded (the benchmark skips the
+  // AABBs of sleeping bodies, which changes the broad phase's order of pairs).
+  s.update_all_aabbs = true;
+  return bench::make_bullet(shapes, method, s, states, dt);
 }
 
 // ---- 2D: Box2D polygon and statsim ------------------------------------------------------------------
@@ -511,7 +340,10 @@ private:
 // ---- the matrix -------------------------------------------------------------------------------------
 class Matrix {
 public:
-  Matrix(const StressOptions& o, Body3 body) : opt_(o), body_(std::move(body)) {}
+  Matrix(const StressOptions& o, Body3 body)
+      : opt_(o), body_(std::move(body)), shapes_(bench::make_bullet_shapes(body_))
+  {
+  }
 
   bool want(const std::string& m) const
   {
@@ -547,9 +379,16 @@ public:
   void long_run();
   void bad_input();
 
+  std::unique_ptr<bench::Sim> sim3(const std::string& method, const Setup3& setup,
+                                   const std::vector<scenes::BodyState3>& states, double dt) const
+  {
+    return make_sim3(body_, shapes_, method, setup, states, dt);
+  }
+
 private:
   StressOptions opt_;
   Body3 body_;
+  std::shared_ptr<bench::BulletShapes> shapes_;
   std::vector<StressCell> cells_;
 };
 
@@ -586,19 +425,20 @@ void Matrix::fast_impact()
         states.push_back(s);
       }
     for (const std::string& m : methods3()) {
-      auto sim = make_sim3(body_, m, Setup3{}, states);
+      auto sim = sim3(m, Setup3{}, states, dt);
       double pen = 0;
       std::vector<bool> through(states.size(), false);
       for (int k = 0; k < steps; ++k) {
-        sim->step(dt);
-        for (std::size_t i = 0; i < sim->size(); ++i) {
+        sim->step();
+        for (std::size_t i = 0; i < sim->body_count(); ++i) {
           pen = std::max(pen, -sim->lowest(i));
-          const State3 s = sim->state(i);
-          if (!finite3(s.x) || s.x.z() < -R()) through[i] = true;
+          const Eigen::Vector3d x = sim->body_state(i).position;
+          if (!finite3(x) || x.z() < -R()) through[i] = true;
         }
       }
       int tunnelled = 0;
-      for (std::size_t i = 0; i < sim->size(); ++i) tunnelled += through[i] || sim->state(i).x.z() < 0;
+      for (std::size_t i = 0; i < sim->body_count(); ++i)
+        tunnelled += through[i] || sim->body_state(i).position.z() < 0;
       add(scene, m, tunnelled == 0 && pen <= 0.25 * R(),
           fmt("tunnelled %d/%zu, max penetration %.1f cm", tunnelled, states.size(), 100 * pen), criterion);
     }
@@ -663,19 +503,16 @@ void Matrix::large_time_step()
     const std::string criterion =
         fmt("lost = 0 and max speed <= 1.25 (free-fall speed + g dt) = %.1f m/s", bound);
     for (const std::string& m : methods3()) {
-      auto sim = make_sim3(body_, m, Setup3{}, scene.bodies);
+      auto sim = sim3(m, Setup3{}, scene.bodies, dt);
       double vmax = 0;
       for (int k = 0; k < steps; ++k) {
-        sim->step(dt);
-        for (std::size_t i = 0; i < sim->size(); ++i) {
-          const double v = sim->state(i).v.norm();
-          vmax = std::isfinite(v) ? std::max(vmax, v) : kInf;
-        }
+        sim->step();
+        vmax = max_speed(*sim, vmax);
       }
       int lost = 0;
-      for (std::size_t i = 0; i < sim->size(); ++i) {
-        const State3 s = sim->state(i);
-        lost += !finite3(s.x) || s.x.z() < -R() || std::fabs(s.x.x()) > 50 || std::fabs(s.x.y()) > 50;
+      for (std::size_t i = 0; i < sim->body_count(); ++i) {
+        const Eigen::Vector3d x = sim->body_state(i).position;
+        lost += !finite3(x) || x.z() < -R() || std::fabs(x.x()) > 50 || std::fabs(x.y()) > 50;
       }
       add(name, m, lost == 0 && vmax <= bound, fmt("max speed %.2f m/s, lost %d/50", vmax, lost), criterion);
     }
@@ -706,14 +543,14 @@ void Matrix::deep_pile()
         (stat ? std::string("max sphere overlap <= 20% of the radius sum (each second of the last 5 s)")
               : fmt("max contact penetration <= 0.2 R = %.1f cm (each second of the last 5 s)", 20 * R()));
     const Clock::time_point t0 = Clock::now();
-    auto sim = make_sim3(body_, m, setup, scene.bodies);
+    auto sim = sim3(m, setup, scene.bodies, dt);
     const double build_s = seconds_since(t0);
     double overlap = 0, overlap_all = 0;
     int done = 0;
     double step_s = 0;
     for (; done < steps; ++done) {
       const Clock::time_point s0 = Clock::now();
-      sim->step(dt);
+      sim->step();
       step_s += seconds_since(s0);
       // Once per simulated second (the statsim measure visits every pair of bodies).
       if ((done + 1) % 60 == 0) {
@@ -730,17 +567,17 @@ void Matrix::deep_pile()
                      1e3 * step_s / (done + 1));
     }
     std::size_t asleep = 0;
-    for (std::size_t i = 0; i < sim->size(); ++i) asleep += sim->state(i).asleep;
+    for (std::size_t i = 0; i < sim->body_count(); ++i) asleep += sim->body_asleep(i);
     const double ke = sim->kinetic_energy();
-    const double frac = double(asleep) / double(sim->size());
+    const double frac = double(asleep) / double(sim->body_count());
     const double ms = 1e3 * step_s / std::max(done, 1);
-    std::string figure = fmt("KE %.3g J (%.2g J/body), asleep %.1f%%, ", ke, ke / double(sim->size()), 100 * frac) +
+    std::string figure = fmt("KE %.3g J (%.2g J/body), asleep %.1f%%, ", ke, ke / double(sim->body_count()), 100 * frac) +
                          (stat ? fmt("max overlap %.1f%% of radius sum (whole run %.1f%%)", 100 * overlap,
                                      100 * overlap_all)
                                : fmt("max penetration %.2f cm (whole run %.2f cm)", 100 * overlap,
                                      100 * overlap_all)) +
                          fmt(", %.2f ms/step", ms);
-    bool pass = frac >= 0.95 && ke <= ke_per_body * double(sim->size()) && overlap <= (stat ? 0.2 : 0.2 * R());
+    bool pass = frac >= 0.95 && ke <= ke_per_body * double(sim->body_count()) && overlap <= (stat ? 0.2 : 0.2 * R());
     if (done < steps) {
       figure += fmt("; stopped at %.1f s simulated (budget %.0f s wall)", done * dt, budget());
       pass = false;
@@ -776,9 +613,9 @@ std::vector<scenes::BodyState3> box_states(int n, double half, double speed, std
   return out;
 }
 
-std::vector<PlaneSpec> closed_box(double half)
+std::vector<bullet::Plane> closed_box(double half)
 {
-  std::vector<PlaneSpec> p;
+  std::vector<bullet::Plane> p;
   for (int a = 0; a < 3; ++a)
     for (const double sgn : {1.0, -1.0}) {
       Eigen::Vector3d n = Eigen::Vector3d::Zero();
@@ -801,13 +638,13 @@ void Matrix::energy()
   setup.restitution = 1;
   setup.friction = 0;
   const std::string criterion = "kinetic energy never above its start (relative tolerance 1e-5)";
-  auto run = [&](const std::string& scene, const std::string& label, std::unique_ptr<Sim3> sim, bool statsim) {
+  auto run = [&](const std::string& scene, const std::string& label, std::unique_ptr<bench::Sim> sim, bool statsim) {
     const double ke0 = sim->kinetic_energy();
     double hi = ke0;
     int done = 0;
     const Clock::time_point t0 = Clock::now();
     for (; done < steps; ++done) {
-      sim->step(dt);
+      sim->step();
       const double ke = sim->kinetic_energy();
       hi = std::isfinite(ke) ? std::max(hi, ke) : kInf;
       if (!statsim && seconds_since(t0) > budget()) {
@@ -829,11 +666,11 @@ void Matrix::energy()
   for (const std::string& m : methods3()) {
     Setup3 s = setup;
     s.particle = m == "statistical";
-    run(scene, m == "statistical" ? "statistical" : m, make_sim3(body_, m, s, states), m == "statistical");
+    run(scene, m == "statistical" ? "statistical" : m, sim3(m, s, states, dt), m == "statistical");
   }
   if (want("statistical"))
     run(fmt("energy, statistical responses, %d steps", steps), "statistical",
-        make_sim3(body_, "statistical", setup, states), true);
+        sim3("statistical", setup, states, dt), true);
 }
 
 // 5. out-of-range states -------------------------------------------------------------------------------
@@ -910,38 +747,35 @@ void Matrix::out_of_range()
       if (c.at_rest)
         for (std::size_t k = 0; k < states.size(); ++k)
           states[k].position.z() = m == "statistical" ? double(sig.rest.heights[k])
-                                                      : -lowest_offset(body_, m, states[k].orientation);
-      auto sim = make_sim3(body_, m, Setup3{}, states);
+                                                      : -bench::lowest_offset(body_, m, states[k].orientation);
+      auto sim = sim3(m, Setup3{}, states, dt);
       const int steps = static_cast<int>(std::lround(c.T / dt));
       double vmax = 0, displaced = 0;
       const double mass = m == "statistical" ? double(sig.mass) : body_.mass;
       const auto total_energy = [&]() {
         double e = sim->kinetic_energy();
-        for (std::size_t i = 0; i < sim->size(); ++i) e += mass * kG * sim->state(i).x.z();
+        for (std::size_t i = 0; i < sim->body_count(); ++i) e += mass * kG * sim->body_state(i).position.z();
         return e;
       };
       const double e0 = total_energy();
       double emax = e0;
       int nan = 0;
       for (int k = 0; k < steps; ++k) {
-        sim->step(dt);
-        for (std::size_t i = 0; i < sim->size(); ++i) {
-          const State3 s = sim->state(i);
-          const double v = s.v.norm();
-          vmax = std::isfinite(v) ? std::max(vmax, v) : kInf;
-        }
+        sim->step();
+        vmax = max_speed(*sim, vmax);
         if (c.energy) {
           const double e = total_energy();
           emax = std::isfinite(e) ? std::max(emax, e) : kInf;
         }
       }
       int lost = 0;
-      for (std::size_t i = 0; i < sim->size(); ++i) {
-        const State3 s = sim->state(i);
-        const bool bad = !finite3(s.x) || !finite3(s.v) || !finite3(s.w) || !std::isfinite(s.q.norm());
+      for (std::size_t i = 0; i < sim->body_count(); ++i) {
+        const scenes::BodyState3 s = sim->body_state(i);
+        const bool bad = !finite3(s.position) || !finite3(s.linear_velocity) || !finite3(s.angular_velocity) ||
+                         !std::isfinite(s.orientation.norm());
         nan += bad;
-        lost += !bad && s.x.z() < -R();
-        if (!bad) displaced = std::max(displaced, (s.x - states[i].position).norm());
+        lost += !bad && s.position.z() < -R();
+        if (!bad) displaced = std::max(displaced, (s.position - states[i].position).norm());
       }
       std::string figure = fmt("non-finite %d, lost %d, max speed %.3g m/s", nan, lost, vmax);
       std::string criterion = fmt("no non-finite state, nothing below the ground, max speed <= %.3g m/s",
@@ -959,8 +793,8 @@ void Matrix::out_of_range()
         pass = pass && displaced <= 0.25 * R();
       }
       if (c.name.rfind("two bodies", 0) == 0) {
-        const double sep1 = (sim->state(0).x - sim->state(1).x).norm();
-        const double sep2 = (sim->state(2).x - sim->state(3).x).norm();
+        const double sep1 = (sim->body_state(0).position - sim->body_state(1).position).norm();
+        const double sep2 = (sim->body_state(2).position - sim->body_state(3).position).norm();
         figure += fmt(", final separations %.3f and %.3f m", sep1, sep2);
       }
       add("out of range: " + c.name, m, pass, figure, criterion);
@@ -983,21 +817,21 @@ void Matrix::long_run()
   double sleeper_drift = 0, creep = 0, ms = 0;
   std::size_t awake_end = 0;
   for (int run = 0; run < 2; ++run) {
-    StatsimSim3<1024> sim(body_, Setup3{}, scene.bodies);
+    StatsimSim3<1024> sim(Setup3{}, scene.bodies, dt);
     std::vector<Eigen::Vector3d> at_snap;
-    std::vector<bool> slept(sim.size(), false);
+    std::vector<bool> slept(sim.body_count(), false);
     const Clock::time_point t0 = Clock::now();
     for (long k = 1; k <= steps; ++k) {
-      sim.step(dt);
+      sim.step();
       if (k == snap_step) {
-        for (std::size_t i = 0; i < sim.size(); ++i) {
-          at_snap.push_back(sim.state(i).x);
-          slept[i] = sim.state(i).asleep;
+        for (std::size_t i = 0; i < sim.body_count(); ++i) {
+          at_snap.push_back(sim.body_state(i).position);
+          slept[i] = sim.body_asleep(i);
         }
       } else if (k > snap_step) {
         // A body counts as a sleeper if it has been asleep at every step since the snapshot.
-        for (std::size_t i = 0; i < sim.size(); ++i)
-          if (slept[i] && sim.world().body(static_cast<BodyId>(i)).state != MotionState::asleep) slept[i] = false;
+        for (std::size_t i = 0; i < sim.body_count(); ++i)
+          if (slept[i] && !sim.body_asleep(i)) slept[i] = false;
       }
       if (opt_.progress && k % 36000 == 0)
         std::fprintf(stderr, "stress: long run %d: %.0f s simulated, %.3f ms/step\n", run + 1, double(k) * dt,
@@ -1006,16 +840,16 @@ void Matrix::long_run()
     ms = 1e3 * seconds_since(t0) / double(steps);
     hashes[run] = sim.hash();
     if (run == 0) {
-      for (std::size_t i = 0; i < sim.size(); ++i) {
-        const State3 s = sim.state(i);
-        if (!finite3(s.x) || !finite3(s.v)) {
+      for (std::size_t i = 0; i < sim.body_count(); ++i) {
+        const scenes::BodyState3 s = sim.body_state(i);
+        if (!finite3(s.position) || !finite3(s.linear_velocity)) {
           ++nan;
           continue;
         }
-        const double d = (s.x - at_snap[i]).norm();
+        const double d = (s.position - at_snap[i]).norm();
         creep = std::max(creep, d);
         if (slept[i]) sleeper_drift = std::max(sleeper_drift, d);
-        awake_end += !s.asleep;
+        awake_end += !sim.body_asleep(i);
       }
     }
   }
@@ -1146,7 +980,7 @@ std::vector<StressCell> run_stress(const StressOptions& options)
                                   "statistical2d)");
   if (!(options.budget_s > 0)) throw std::invalid_argument("--budget must be positive");
   const std::string dir = options.meshes_dir.empty() ? std::string(STATSIM_STRESS_MESHES_DIR) : options.meshes_dir;
-  Matrix mx(options, bench::load_body3("bunny", dir, false));
+  Matrix mx(options, bench::load_body3("bunny", dir));
   mx.bad_input();
   mx.fast_impact();
   mx.large_time_step();

@@ -1,20 +1,16 @@
-// Bullet 3 for the benchmark, warnings silenced: include Bullet only through this header.
+// Bullet 3 (Debian libbullet-dev, double-precision build) for the host tools, with its warnings
+// silenced: include Bullet only through this header. The runtime never includes it.
 //
-// The benchmark uses Bullet's double-precision build (Debian's *-float64 libraries,
-// BT_USE_DOUBLE_PRECISION) because tools/ref3d links it into the same `statsim` executable: the
-// float and double builds export the same symbols and cannot share a process. On x86-64 Linux
-// neither build uses Bullet's SSE paths (btScalar.h enables them only for MSVC and Apple), so the
-// difference is the width of the numbers. tools/ref3d/bullet.hpp is used when present (one
-// wrapper for the project), else the same includes here.
+// The double-precision libraries (*-float64, BT_USE_DOUBLE_PRECISION) are the only Bullet build
+// linked: the float and double builds export the same symbols and cannot share the `statsim`
+// executable. On x86-64 Linux neither build uses Bullet's SSE paths (btScalar.h enables them only
+// for MSVC and Apple), so the choice changes only the width of the numbers.
 #pragma once
 
 #ifndef BT_USE_DOUBLE_PRECISION
-#error "tools/bench uses Bullet's double-precision libraries: compile with -DBT_USE_DOUBLE_PRECISION"
+#error "the host tools use Bullet's double-precision libraries: compile with -DBT_USE_DOUBLE_PRECISION"
 #endif
 
-#if __has_include("ref3d/bullet.hpp")
-#include "ref3d/bullet.hpp"
-#else
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wall"
 #pragma GCC diagnostic ignored "-Wextra"
@@ -35,5 +31,21 @@
 #include <btBulletDynamicsCommon.h>
 #include <BulletCollision/Gimpact/btGImpactCollisionAlgorithm.h>
 #include <BulletCollision/Gimpact/btGImpactShape.h>
+#include <LinearMath/btConvexHullComputer.h>
 #pragma GCC diagnostic pop
-#endif
+
+#include <Eigen/Core>
+
+namespace statsim::tools::bullet {
+
+inline btVector3 to_bt(const Eigen::Vector3d& v)
+{
+  return btVector3(v.x(), v.y(), v.z());
+}
+
+inline Eigen::Vector3d to_eigen(const btVector3& v)
+{
+  return Eigen::Vector3d(v.x(), v.y(), v.z());
+}
+
+}  // namespace statsim::tools::bullet
