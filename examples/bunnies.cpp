@@ -55,9 +55,14 @@ int main(int argc, char** argv)
   }
   statsim::WorldDef3 def;
   def.seed = o.seed;
-  world.configure(def);
-  const statsim::ShapeId shape = world.add_shape(statsim::tables::bunny.view()).id;
-  world.add_plane(statsim::Vector3(0, 0, 1), 0);
+  const statsim::Status configured = world.configure(def);
+  const statsim::Added<statsim::ShapeId> added = world.add_shape(statsim::tables::bunny.view());
+  const statsim::Added<statsim::PlaneId> ground = world.add_plane(statsim::Vector3(0, 0, 1), 0);
+  if (configured != statsim::Status::ok || !added.ok() || !ground.ok()) {
+    std::fprintf(stderr, "bunnies: world set-up failed\n");
+    return 1;
+  }
+  const statsim::ShapeId shape = added.id;
   statsim::Pcg32 rng(o.seed, 0);
   // A cylinder wide enough for a low pile: radius grows with sqrt(N).
   const float radius = 0.1f * std::sqrt(float(o.n));

@@ -4,6 +4,8 @@
 #include "demo.hpp"
 #include "tables/lshape.hpp"
 
+#include <cstdio>
+
 namespace {
 statsim::World3<2000> world;
 }
@@ -17,9 +19,14 @@ int main(int argc, char** argv)
   if (o.n < 1 || o.n > 2000) return 2;
   statsim::WorldDef3 def;
   def.seed = o.seed;
-  world.configure(def);
-  const statsim::ShapeId shape = world.add_shape(statsim::tables::lshape.view()).id;
-  world.add_plane(statsim::Vector3(0, 0, 1), 0);
+  const statsim::Status configured = world.configure(def);
+  const statsim::Added<statsim::ShapeId> added = world.add_shape(statsim::tables::lshape.view());
+  const statsim::Added<statsim::PlaneId> ground = world.add_plane(statsim::Vector3(0, 0, 1), 0);
+  if (configured != statsim::Status::ok || !added.ok() || !ground.ok()) {
+    std::fprintf(stderr, "drop_lshapes: world set-up failed\n");
+    return 1;
+  }
+  const statsim::ShapeId shape = added.id;
   statsim::Pcg32 rng(o.seed, 0);
   if (!demo::drop_cylinder(world, shape, o.n, 0.4f, 0.3f, 0.012f, rng)) return 1;
   int steps = 0;

@@ -8,6 +8,8 @@
 #include "demo.hpp"
 #include "tables/bunny.hpp"
 
+#include <cstdio>
+
 namespace {
 statsim::World3<1> worlds[2];
 }
@@ -31,9 +33,14 @@ int main(int argc, char** argv)
     def.seed = o.seed;
     def.rest_conditions = k == 1;
     statsim::World3<1>& w = worlds[k];
-    w.configure(def);
-    const statsim::ShapeId shape = w.add_shape(sig).id;
-    w.add_plane(statsim::Vector3(0, 0, 1), 0);
+    const statsim::Status configured = w.configure(def);
+    const statsim::Added<statsim::ShapeId> added = w.add_shape(sig);
+    const statsim::Added<statsim::PlaneId> ground = w.add_plane(statsim::Vector3(0, 0, 1), 0);
+    if (configured != statsim::Status::ok || !added.ok() || !ground.ok()) {
+      std::fprintf(stderr, "rest_conditions: world set-up failed\n");
+      return 1;
+    }
+    const statsim::ShapeId shape = added.id;
     statsim::Pcg32 rng(o.seed, 7);
     if (!demo::drop_cylinder(w, shape, 1, 0.0f, 0.6f, 0.0f, rng)) return 1;
     int steps = 0;

@@ -46,8 +46,11 @@ PairList sweep_and_prune(std::vector<SweepEntry>& entries, const std::vector<Sph
   }
   detail::insertion_sort(entries.data(), std::uint32_t(entries.size()));
   for (std::size_t i = 1; i < entries.size(); ++i) REQUIRE(entries[i - 1].lo <= entries[i].lo);
+  // All entries active: sweep_active reports every overlapping interval pair once.
+  float widest = 0;
+  for (const auto& e : entries) widest = std::max(widest, e.hi - e.lo);
   PairList out;
-  detail::sweep(entries.data(), std::uint32_t(entries.size()), [&](std::uint32_t a, std::uint32_t b) {
+  detail::sweep_active(entries.data(), std::uint32_t(entries.size()), widest, [&](std::uint32_t a, std::uint32_t b) {
     const float reach = s[a].r + s[b].r;
     if ((s[a].c - s[b].c).squaredNorm() <= reach * reach) out.emplace_back(a, b);
   });

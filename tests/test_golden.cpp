@@ -23,9 +23,9 @@ std::uint64_t run_scene(World& w, const Sig& sig)
   ball.radius = 0.12f;
   const ShapeId sphere = w.add_shape(ball).id;
   using Vec = typename Space<D>::Vec;
-  w.add_plane(Vec::Unit(Space<D>::up_axis), 0);
-  w.add_plane(Vec::Unit(0), -2);
-  w.add_plane(-Vec::Unit(0), -2);
+  REQUIRE(w.add_plane(Vec::Unit(Space<D>::up_axis), 0).ok());
+  REQUIRE(w.add_plane(Vec::Unit(0), -2).ok());
+  REQUIRE(w.add_plane(-Vec::Unit(0), -2).ok());
   Pcg32 g(2026, 11);
   for (int i = 0; i < 150; ++i) {
     BodyDef<D> b;

@@ -36,7 +36,7 @@ TEST_CASE("bad input is rejected with its status and the world is unchanged (3D)
 {
   World3<4, 2> w;
   fill_scene(w, 3, 1);
-  for (int i = 0; i < 10; ++i) w.step(1.0f / 60);
+  for (int i = 0; i < 10; ++i) REQUIRE(w.step(1.0f / 60).status == Status::ok);
   const std::uint64_t before = w.state_hash();
   const std::uint32_t bodies = w.body_count();
 
@@ -131,7 +131,7 @@ TEST_CASE("bad input is rejected with state unchanged (2D)")
 {
   World2<2, 1> w;
   fill_scene(w, 1, 2);
-  w.step(1.0f / 60);
+  REQUIRE(w.step(1.0f / 60).status == Status::ok);
   const std::uint64_t before = w.state_hash();
   BodyDef2 d;
   d.orientation = Rot2{0, 0};
@@ -173,7 +173,7 @@ TEST_CASE("a body dropped on the ground comes to rest at height r and falls asle
   CHECK(w3.body(0).linear_velocity.norm() == 0);
   // Asleep means asleep: more steps change nothing.
   const Vector3 rest = w3.body(0).position;
-  for (int i = 0; i < 100; ++i) w3.step(1.0f / 60);
+  for (int i = 0; i < 100; ++i) REQUIRE(w3.step(1.0f / 60).status == Status::ok);
   CHECK(w3.body(0).position == rest);
 
   World2<1, 1> w2;
@@ -183,7 +183,8 @@ TEST_CASE("a body dropped on the ground comes to rest at height r and falls asle
   b2.position = Vector2(0, 3);
   b2.angular_velocity = 2;
   REQUIRE(w2.add_body(b2).ok());
-  for (int i = 0; i < 60 * 10 && w2.body(0).state != MotionState::asleep; ++i) w2.step(1.0f / 60);
+  for (int i = 0; i < 60 * 10 && w2.body(0).state != MotionState::asleep; ++i)
+    REQUIRE(w2.step(1.0f / 60).status == Status::ok);
   CHECK(w2.body(0).state == MotionState::asleep);
   CHECK(w2.body(0).position.y() == doctest::Approx(-0.75).epsilon(1e-4));
 }
@@ -203,7 +204,7 @@ TEST_CASE("a fast body hitting a sleeper wakes it - a slow one rests on it")
   faller.position = Vector3(0.3f, 0, 1.6f);
   faller.linear_velocity = Vector3(0, 0, -3);
   REQUIRE(w.add_body(faller).ok());
-  for (int i = 0; i < 10; ++i) w.step(1.0f / 60);
+  for (int i = 0; i < 10; ++i) REQUIRE(w.step(1.0f / 60).status == Status::ok);
   CHECK(w.body(0).state != MotionState::asleep);
 }
 
@@ -218,9 +219,9 @@ TEST_CASE("two worlds with the same seed stay bit-identical - another seed diffe
   fill_scene(*b, 300, 5);
   fill_scene(*c, 300, 5);
   for (int i = 0; i < 400; ++i) {
-    a->step(1.0f / 60);
-    b->step(1.0f / 60);
-    c->step(1.0f / 60);
+    REQUIRE(a->step(1.0f / 60).status == Status::ok);
+    REQUIRE(b->step(1.0f / 60).status == Status::ok);
+    REQUIRE(c->step(1.0f / 60).status == Status::ok);
     REQUIRE(a->state_hash() == b->state_hash());
   }
   CHECK(a->state_hash() != c->state_hash());  // the per-body random streams differ
