@@ -65,7 +65,7 @@ class WorldCore {
     const Status s = detail::check_shape_def(def, bound);
     if (s != Status::ok) return {s, 0};
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, 0};
-    w_.shapes[w_.shape_count] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius};
+    w_.shapes[w_.shape_count] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius, 0};
     return {Status::ok, ShapeId(w_.shape_count++)};
   }
 
@@ -88,17 +88,17 @@ class WorldCore {
       largest = sig.rest.heights[i] > largest ? sig.rest.heights[i] : largest;
       rest_max = sig.rest.heights[i] > rest_max ? sig.rest.heights[i] : rest_max;
     }
-    const Scalar radius = rest_max > 0 ? rest_max : sig.height.mean[0];
     // The radius of a body at rest on other bodies: the rest heights weighted by how often the
-    // reference came to rest in each pose.
+    // reference came to rest in each pose; without frequencies, the largest rest height (h_coll
+    // at spin 0 without rest poses).
     Scalar weighted = 0, weight = 0;
     for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
       weighted += sig.rest.frequencies[i] * sig.rest.heights[i];
       weight += sig.rest.frequencies[i];
     }
-    const Scalar mean_rest = weight > 0 ? weighted / weight : radius;
+    const Scalar mean_rest = weight > 0 ? weighted / weight : (rest_max > 0 ? rest_max : sig.height.mean[0]);
     Shape<D>& shape = w_.shapes[w_.shape_count];
-    shape = Shape<D>{radius, largest, sig.material, true, sig, {}, mean_rest};
+    shape = Shape<D>{0, largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig)};
     rest_basin_biases<D>(sig, shape.rest_bias.data());
     return {Status::ok, ShapeId(w_.shape_count++)};
   }
@@ -254,8 +254,10 @@ class WorldCore {
     return n;
   }
 
-  /// FNV-1a hash of everything that determines the future: body states, planes, shapes, counts.
-  /// Equal hashes after equal calls show bit-identical worlds.
+  /// FNV-1a hash of everything that determines the future: the parameters (`def()`), body
+  /// states, planes, shapes (materials and signatures), the sweep-and-prune order and the
+  /// counts. Equal hashes show bit-identical worlds that will step alike; worlds that differ in
+  /// anything a step reads hash differently (but for hash collisions).
   std::uint64_t state_hash() const { return detail::state_hash(w_); }
 
  protected:

@@ -86,6 +86,86 @@ void integrate(WorldData<D>& w, Scalar dt)
   }
 }
 
+/// Adds every parameter of a world to a hash. A new `WorldDef` field belongs here too.
+template <int D>
+void hash_def(Fnv1a& h, const WorldDef<D>& d)
+{
+  h.add_vec(d.gravity);
+  h.add(d.seed);
+  h.add(d.restitution_threshold);
+  h.add(d.settle_speed);
+  h.add(d.sleep_speed);
+  h.add(d.sleep_time);
+  h.add(d.wake_speed);
+  h.add(d.linear_damping);
+  h.add(d.angular_damping);
+  h.add(std::int32_t(d.support_iterations));
+  h.add(std::uint8_t(d.shock_propagation));
+  h.add(std::int32_t(d.position_iterations));
+  h.add(d.allowed_overlap);
+  h.add(d.overlap_correction);
+  h.add(d.spin_ratio_speed_floor);
+  h.add(std::uint8_t(d.nearest_radius));
+  h.add(std::uint8_t(d.pair_response));
+  h.add(std::uint8_t(d.rest_conditions));
+  h.add(std::uint8_t(d.pile_rest));
+  h.add(d.rest_blend_time);
+  h.add(d.rest_turn_time);
+  h.add(d.rest_snap_cosine);
+  h.add(d.ground_cosine);
+  h.add(std::uint8_t(d.broad_phase));
+  h.add(d.grid_above_bodies);
+  h.add(std::int32_t(d.sweep_axis));
+}
+
+/// Adds a table's numbers as the runtime reads them (16-bit ones as their values).
+inline void hash_values(Fnv1a& h, const ValuesView& v, std::uint32_t n)
+{
+  for (std::uint32_t i = 0; i < n; ++i) h.add(v[i]);
+}
+inline void hash_axis(Fnv1a& h, const AxisView& a)
+{
+  h.add(a.size);
+  for (std::uint32_t i = 0; i < a.size; ++i) h.add(a.values[i]);
+}
+
+/// FNV-1a hash of everything of a signature that a step reads: its scalars, axes, tables and
+/// rest poses. Computed once, by `add_shape`; the signature must have passed `check_signature`.
+template <int D>
+std::uint64_t signature_hash(const SignatureView<D>& sig)
+{
+  Fnv1a h;
+  h.add(sig.length);
+  h.add(sig.bounding_radius);
+  h.add(sig.mass);
+  for (const Scalar x : sig.unit_inertia) h.add(x);
+  h.add(sig.material.restitution);
+  h.add(sig.material.friction);
+  h.add(sig.material.rolling_resistance);
+  h.add(sig.restitution_threshold);
+  h.add(std::uint8_t(sig.layout));
+  hash_axis(h, sig.height.spin_ratio);
+  hash_values(h, sig.height.mean, sig.height.spin_ratio.size);
+  hash_values(h, sig.height.stddev, sig.height.spin_ratio.size);
+  const ResponseTableView& r = sig.response;
+  h.add(r.axis_count);
+  h.add(r.components);
+  std::uint32_t values = r.components;
+  for (std::uint32_t a = 0; a < r.axis_count; ++a) {
+    hash_axis(h, r.axes[a]);
+    values *= r.axes[a].size;
+  }
+  hash_values(h, r.mean, values);
+  hash_values(h, r.stddev, values);
+  h.add(sig.rest.count);
+  for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+    h.add_vec(sig.rest.normal(i));
+    h.add(sig.rest.heights[i]);
+    h.add(sig.rest.frequencies[i]);
+  }
+  return h.value;
+}
+
 /// FNV-1a hash of the world's state (see `WorldCore::state_hash`).
 template <int D>
 std::uint64_t state_hash(const WorldData<D>& w)
@@ -95,6 +175,7 @@ std::uint64_t state_hash(const WorldData<D>& w)
   h.add(w.plane_count);
   h.add(w.shape_count);
   h.add(w.step_count);
+  hash_def(h, w.def);
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     const Body<D>& b = w.bodies[i];
     h.add_vec(b.position);
@@ -119,11 +200,22 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add(w.planes[i].offset);
   }
   for (std::uint32_t i = 0; i < w.shape_count; ++i) {
-    h.add(w.shapes[i].radius);
-    h.add(w.shapes[i].bounding_radius);
-    h.add(w.shapes[i].material.restitution);
-    h.add(w.shapes[i].material.friction);
+    const Shape<D>& s = w.shapes[i];
+    h.add(s.radius);
+    h.add(s.bounding_radius);
+    h.add(s.material.restitution);
+    h.add(s.material.friction);
+    h.add(s.material.rolling_resistance);
+    h.add(std::uint8_t(s.statistical));
+    if (!s.statistical) continue;
+    h.add(s.signature_hash);
+    h.add(s.mean_rest_height);
+    for (std::uint32_t k = 0; k < s.signature.rest.count; ++k) h.add(s.rest_bias[k]);
   }
+  // The sweep-and-prune order breaks ties between equal interval starts, so it decides the order
+  // of pairs, and with it of contacts.
+  h.add(w.entry_count);
+  for (std::uint32_t i = 0; i < w.entry_count; ++i) h.add(w.entries[i].body);
   return h.value;
 }
 

@@ -208,7 +208,9 @@ struct [[nodiscard]] Added {
 /// the particle response.
 template <int D>
 struct Shape {
-  Scalar radius;            ///< m; for statistical shapes the radius at rest (largest h_rest)
+  /// Collision radius of a plain sphere, m; 0 for a statistical shape, whose bodies take theirs
+  /// from the signature.
+  Scalar radius;
   Scalar bounding_radius;   ///< m
   Material material;
   bool statistical;
@@ -218,6 +220,9 @@ struct Shape {
   /// Frequency-weighted mean of the rest heights, m: the radius a body blends to while it
   /// settles on other bodies (`WorldDef::pile_rest`).
   Scalar mean_rest_height;
+  /// FNV-1a hash of the signature's numbers (`detail::signature_hash`), for `state_hash`; 0 for
+  /// a plain sphere.
+  std::uint64_t signature_hash;
 };
 
 }  // namespace statsim
