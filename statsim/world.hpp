@@ -189,7 +189,7 @@ class WorldCore {
       result.status = Status::invalid_time_step;
       return result;
     }
-    detail::StepContext ctx{dt};
+    detail::StepContext ctx;
     detail::integrate(w_, dt);
     detail::update_radii(w_);
     detail::find_pairs(w_, result);

@@ -33,7 +33,6 @@ struct WorldData {
 
 /// What one step counts as its phases run; the passes reset the counter they test.
 struct StepContext {
-  Scalar dt;
   /// Body-body contacts of the impact pass: the pairs at the front of the pair buffer that the
   /// later passes visit.
   std::uint32_t touching = 0;
