@@ -122,15 +122,22 @@ int main(int argc, char** argv)
 
   WorldDef2 def;
   def.seed = seed;
-  world.configure(def);
+  bool set_up = world.configure(def) == Status::ok;
   const SignatureView<2> signatures[2] = {tables::square2d.view(), tables::lshape2d.view()};
   const Outline outlines[2] = {centred(square_outline, 4), centred(lshape_corners, 6)};
   ShapeId shapes[2];
-  for (int s = 0; s < 2; ++s) shapes[s] = world.add_shape(signatures[s]).id;
-  world.add_plane(Vector2(0, 1), 0);
+  for (int s = 0; s < 2; ++s) {
+    const Added<ShapeId> added = world.add_shape(signatures[s]);
+    set_up = set_up && added.ok();
+    shapes[s] = added.id;
+  }
   const float half_width = 2.0f * std::sqrt(float(n));  // walls far enough out for a low pile
-  world.add_plane(Vector2(1, 0), -half_width);
-  world.add_plane(Vector2(-1, 0), -half_width);
+  set_up = set_up && world.add_plane(Vector2(0, 1), 0).ok() && world.add_plane(Vector2(1, 0), -half_width).ok() &&
+           world.add_plane(Vector2(-1, 0), -half_width).ok();
+  if (!set_up) {
+    std::fprintf(stderr, "drop2d: world set-up failed\n");
+    return 1;
+  }
 
   Pcg32 rng(seed, 1000);
   for (long i = 0; i < 2 * n; ++i) {

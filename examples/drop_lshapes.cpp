@@ -4,6 +4,8 @@
 #include "demo.hpp"
 #include "tables/lshape.hpp"
 
+#include <cstdio>
+
 namespace {
 statsim::World3<2000> world;
 }

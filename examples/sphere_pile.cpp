@@ -26,12 +26,15 @@ int main(int argc, char** argv)
   ball.radius = 0.1f;  // 20 cm spheres
   ball.material.restitution = 0.4f;
   ball.material.friction = 0.5f;
-  const ShapeId shape = world.add_shape(ball).id;
-  world.add_plane(Vector3(0, 0, 1), 0);  // ground
-  for (int k = 0; k < 2; ++k) {          // four walls 1.5 m from the centre
-    world.add_plane(Vector3::Unit(k), -1.5f);
-    world.add_plane(-Vector3::Unit(k), -1.5f);
+  const Added<ShapeId> added = world.add_shape(ball);
+  bool set_up = added.ok() && world.add_plane(Vector3(0, 0, 1), 0).ok();  // ground
+  for (int k = 0; k < 2; ++k)  // four walls 1.5 m from the centre
+    set_up = set_up && world.add_plane(Vector3::Unit(k), -1.5f).ok() && world.add_plane(-Vector3::Unit(k), -1.5f).ok();
+  if (!set_up) {
+    std::fprintf(stderr, "sphere_pile: world set-up failed\n");
+    return 1;
   }
+  const ShapeId shape = added.id;
 
   // A column of bodies above the box, with random sideways velocities and spins.
   Pcg32 rng(2024, 0);

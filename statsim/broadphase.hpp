@@ -50,23 +50,12 @@ inline std::uint32_t insertion_sort(SweepEntry* entries, std::uint32_t count)
   return moves;
 }
 
-/// Calls `overlap(body_a, body_b)` for every pair of entries whose intervals overlap
-/// (lo_b <= hi_a with b after a in the sorted order). `entries` must be sorted by lo.
-template <class OnOverlap>
-void sweep(const SweepEntry* entries, std::uint32_t count, OnOverlap&& overlap)
-{
-  for (std::uint32_t i = 0; i < count; ++i) {
-    const Scalar hi = entries[i].hi;
-    const std::uint32_t a = entries[i].body;
-    for (std::uint32_t j = i + 1; j < count && entries[j].lo <= hi; ++j) overlap(a, entries[j].body);
-  }
-}
-
-/// Like `sweep`, but only for pairs with at least one active entry, at a cost that grows with
-/// the active entries rather than all of them (a settled pile of sleepers costs nearly nothing).
-/// From each active entry it scans forward as `sweep` does, and backward for inactive entries
-/// whose interval reaches it: sorted by lo, those start no earlier than lo - `max_width`, the
-/// widest interval.
+/// Calls `overlap(body_a, body_b)` for every pair of entries whose intervals overlap and of which
+/// at least one is active, at a cost that grows with the active entries rather than all of them
+/// (a settled pile of sleepers costs nearly nothing). `entries` must be sorted by lo. From each
+/// active entry it scans forward until lo passes its hi, and backward for inactive entries whose
+/// interval reaches it: sorted by lo, those start no earlier than lo - `max_width`, the widest
+/// interval.
 template <class OnOverlap>
 void sweep_active(const SweepEntry* entries, std::uint32_t count, Scalar max_width, OnOverlap&& overlap)
 {
@@ -94,9 +83,8 @@ enum class BroadPhase : std::uint8_t {
   /// Sweep-and-prune along one axis (paper 4.1). Cost grows with the bodies whose intervals
   /// overlap on that axis, which in a wide pile is many more than the true neighbours.
   sweep_and_prune,
-  /// Sweep-and-prune up to `WorldDef::grid_above_bodies` bodies, the grid above. Measured with
-  /// `statsim bench` (bunny drop, this repository's README): sweep-and-prune took 0.58x of the
-  /// grid's time at 100 bodies and 0.77x at 1,000, the grid 0.67x of sweep-and-prune's at 10,000.
+  /// Sweep-and-prune up to `WorldDef::grid_above_bodies` bodies, the grid above: sweep-and-prune
+  /// is the faster in small worlds, the grid in large ones (`statsim bench`, tools/bench/README.md).
   automatic,
 };
 

@@ -30,7 +30,6 @@ struct Rot2 {
   Scalar c = 1;  ///< cos of the angle
   Scalar s = 0;  ///< sin of the angle
 
-  static Rot2 identity() { return {}; }
   /// From an angle in radians (counter-clockwise). Uses std::cos/std::sin: call it when setting
   /// up a scene, not inside a deterministic step.
   static Rot2 from_angle(Scalar radians) { return {std::cos(radians), std::sin(radians)}; }
@@ -38,7 +37,6 @@ struct Rot2 {
   Scalar angle() const { return std::atan2(s, c); }
   Vector2 operator*(const Vector2& v) const { return {c * v.x() - s * v.y(), s * v.x() + c * v.y()}; }
   Rot2 operator*(const Rot2& o) const { return {c * o.c - s * o.s, s * o.c + c * o.s}; }
-  Rot2 inverse() const { return {c, -s}; }
   Scalar squared_norm() const { return c * c + s * s; }
 };
 

@@ -47,6 +47,59 @@ struct ContactSide {
   Scalar radius;
 };
 
+namespace detail {
+
+/// Normal and friction impulse of a contact whose relative contact velocity `u` approaches
+/// along the unit normal `n` at `vn` < 0 (writes the normal impulse to `jn`): restitution above
+/// `restitution_threshold`, and the tangential impulse the lesser of mu j_n and the impulse
+/// `slip / compliance` that stops the slip.
+template <int D>
+typename Space<D>::Vec contact_impulse(const typename Space<D>::Vec& u, const typename Space<D>::Vec& n, Scalar vn,
+                                       Scalar inv_mass_sum, Scalar compliance, const Material& m,
+                                       Scalar restitution_threshold, Scalar& jn)
+{
+  using Vec = typename Space<D>::Vec;
+  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
+  jn = -(1 + e) * vn / inv_mass_sum;
+  Vec impulse = n * jn;
+  const Vec ut = u - n * vn;
+  const Scalar slip = ut.norm();
+  if (slip > Scalar(0)) {
+    const Scalar jt_stick = slip / compliance;
+    const Scalar jt_slide = m.friction * jn;
+    const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
+    impulse -= ut * (jt / slip);
+  }
+  return impulse;
+}
+
+/// Rolling resistance after a normal impulse `jn`: each body's tangential velocity relative to
+/// the other and its spin shrink by the same factor, which takes at most
+/// rolling_resistance * j_n * inv_mass off the rolling speed and never adds energy (a factor in
+/// [0, 1] on each term).
+template <int D>
+void rolling_resistance(ContactSide<D>& a, ContactSide<D>& b, const typename Space<D>::Vec& n, Scalar jn,
+                        Scalar inv_mass_sum, const Material& m)
+{
+  using Vec = typename Space<D>::Vec;
+  if (!(m.rolling_resistance > 0)) return;
+  const Vec rel = b.velocity - a.velocity;
+  const Vec rel_t = rel - n * rel.dot(n);
+  const Scalar speed = rel_t.norm();
+  const Scalar cut = m.rolling_resistance * jn * inv_mass_sum;
+  const Scalar f = speed > cut ? 1 - cut / speed : Scalar(0);
+  // Both tangential velocities move toward their mass-weighted mean, which conserves momentum
+  // and leaves a static side (inverse mass 0) where it is.
+  const Vec mean = (a.velocity * b.inv_mass + b.velocity * a.inv_mass) / inv_mass_sum;
+  const Vec mean_t = mean - n * mean.dot(n);
+  a.velocity += (a.velocity - n * a.velocity.dot(n) - mean_t) * (f - 1);
+  b.velocity += (b.velocity - n * b.velocity.dot(n) - mean_t) * (f - 1);
+  if (a.inv_mass > 0) a.spin = a.spin * f;
+  if (b.inv_mass > 0) b.spin = b.spin * f;
+}
+
+}  // namespace detail
+
 /// Resolves the contact of `a` and `b` along the unit normal `n` (pointing from a to b).
 /// Returns true when the bodies were approaching and an impulse was applied. Below
 /// `restitution_threshold` (m/s of approach) the contact is treated as inelastic, so that resting
@@ -67,89 +120,37 @@ bool particle_response(ContactSide<D> a, ContactSide<D> b, const typename Space<
   // and by j / m on a point particle.
   const Scalar compliance = a.inv_mass * (a.radius > 0 ? 1 + inv_k : Scalar(1)) +
                             b.inv_mass * (b.radius > 0 ? 1 + inv_k : Scalar(1));
-
-  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
-  const Scalar jn = -(1 + e) * vn / inv_mass_sum;
-  Vec impulse = n * jn;
-
-  const Vec ut = u - n * vn;
-  const Scalar slip = ut.norm();
-  if (slip > Scalar(0)) {
-    const Scalar jt_stick = slip / compliance;
-    const Scalar jt_slide = m.friction * jn;
-    const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
-    impulse -= ut * (jt / slip);
-  }
+  Scalar jn;
+  const Vec impulse = detail::contact_impulse<D>(u, n, vn, inv_mass_sum, compliance, m, restitution_threshold, jn);
   // Impulse `impulse` acts on b at rb and its opposite on a at ra; I^-1 = inv_mass / (k R^2).
   b.velocity += impulse * b.inv_mass;
   a.velocity -= impulse * a.inv_mass;
   if (b.radius > 0) b.spin += detail::moment(rb, impulse) * (b.inv_mass * inv_k / (b.radius * b.radius));
   if (a.radius > 0) a.spin -= detail::moment(ra, impulse) * (a.inv_mass * inv_k / (a.radius * a.radius));
-
-  // Rolling resistance: each body's tangential velocity relative to the other and its spin
-  // shrink by the same factor, which takes at most rolling_resistance * j_n * inv_mass off the
-  // rolling speed and never adds energy (a factor in [0, 1] on each term).
-  if (m.rolling_resistance > 0) {
-    const Vec rel = b.velocity - a.velocity;
-    const Vec rel_t = rel - n * rel.dot(n);
-    const Scalar speed = rel_t.norm();
-    const Scalar cut = m.rolling_resistance * jn * inv_mass_sum;
-    const Scalar f = speed > cut ? 1 - cut / speed : Scalar(0);
-    // Both tangential velocities move toward their mass-weighted mean, which conserves momentum
-    // and leaves a static side (inverse mass 0) where it is.
-    const Vec mean = (a.velocity * b.inv_mass + b.velocity * a.inv_mass) / inv_mass_sum;
-    const Vec mean_t = mean - n * mean.dot(n);
-    a.velocity += (a.velocity - n * a.velocity.dot(n) - mean_t) * (f - 1);
-    b.velocity += (b.velocity - n * b.velocity.dot(n) - mean_t) * (f - 1);
-    if (a.inv_mass > 0) a.spin = a.spin * f;
-    if (b.inv_mass > 0) b.spin = b.spin * f;
-  }
+  detail::rolling_resistance(a, b, n, jn, inv_mass_sum, m);
   return true;
 }
 
 /// The same rule as `particle_response` for two point-like sides (radius 0: statistical bodies,
 /// whose spheres are not their shapes): the impulses do not turn them, and only rolling
-/// resistance slows their spins. The terms of the radii vanish exactly (w x 0 = 0, x + 0 = x), so
-/// the result is bit for bit that of `particle_response` with both radii 0; written out because
-/// it runs for every touching pair of statistical bodies in every contact pass.
+/// resistance slows their spins. The terms of the radii vanish exactly (w x 0 = 0, x + 0 = x,
+/// compliance = sum of inverse masses), so the result is bit for bit that of `particle_response`
+/// with both radii 0 (tests/test_contacts.cpp checks it); written out because it runs for every
+/// touching pair of statistical bodies in every contact pass.
 template <int D>
 bool particle_point_response(ContactSide<D> a, ContactSide<D> b, const typename Space<D>::Vec& n, const Material& m,
                              Scalar restitution_threshold)
 {
-  typename Space<D>::Vec& va = a.velocity;
-  typename Space<D>::Vec& vb = b.velocity;
-  const Scalar inv_mass_a = a.inv_mass, inv_mass_b = b.inv_mass;
   using Vec = typename Space<D>::Vec;
-  const Vec u = vb - va;
+  const Vec u = b.velocity - a.velocity;
   const Scalar vn = u.dot(n);
-  const Scalar inv_mass_sum = inv_mass_a + inv_mass_b;
+  const Scalar inv_mass_sum = a.inv_mass + b.inv_mass;
   if (vn >= 0 || inv_mass_sum <= 0) return false;
-  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
-  const Scalar jn = -(1 + e) * vn / inv_mass_sum;
-  Vec impulse = n * jn;
-  const Vec ut = u - n * vn;
-  const Scalar slip = ut.norm();
-  if (slip > Scalar(0)) {
-    const Scalar jt_stick = slip / inv_mass_sum;
-    const Scalar jt_slide = m.friction * jn;
-    const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
-    impulse -= ut * (jt / slip);
-  }
-  vb += impulse * inv_mass_b;
-  va -= impulse * inv_mass_a;
-  if (m.rolling_resistance > 0) {
-    const Vec rel = vb - va;
-    const Vec rel_t = rel - n * rel.dot(n);
-    const Scalar speed = rel_t.norm();
-    const Scalar cut = m.rolling_resistance * jn * inv_mass_sum;
-    const Scalar f = speed > cut ? 1 - cut / speed : Scalar(0);
-    const Vec mean = (va * inv_mass_b + vb * inv_mass_a) / inv_mass_sum;
-    const Vec mean_t = mean - n * mean.dot(n);
-    va += (va - n * va.dot(n) - mean_t) * (f - 1);
-    vb += (vb - n * vb.dot(n) - mean_t) * (f - 1);
-    if (inv_mass_a > 0) a.spin = a.spin * f;
-    if (inv_mass_b > 0) b.spin = b.spin * f;
-  }
+  Scalar jn;
+  const Vec impulse = detail::contact_impulse<D>(u, n, vn, inv_mass_sum, inv_mass_sum, m, restitution_threshold, jn);
+  b.velocity += impulse * b.inv_mass;
+  a.velocity -= impulse * a.inv_mass;
+  detail::rolling_resistance(a, b, n, jn, inv_mass_sum, m);
   return true;
 }
 
@@ -168,17 +169,9 @@ bool particle_plane_response(typename Space<D>::Vec& velocity, typename Space<D>
   const Scalar vn = u.dot(n);
   if (vn >= 0) return false;
   const Scalar compliance = radius > 0 ? 1 + inv_k : Scalar(1);
-  const Scalar e = -vn > restitution_threshold ? m.restitution : Scalar(0);
-  const Scalar jn = -(1 + e) * vn;
-  Vec impulse = n * jn;
-  const Vec ut = u - n * vn;
-  const Scalar slip = ut.norm();
-  if (slip > Scalar(0)) {
-    const Scalar jt_stick = slip / compliance;
-    const Scalar jt_slide = m.friction * jn;
-    const Scalar jt = jt_stick < jt_slide ? jt_stick : jt_slide;
-    impulse -= ut * (jt / slip);
-  }
+  // A unit inverse mass: j_n / 1 is j_n exactly.
+  Scalar jn;
+  const Vec impulse = detail::contact_impulse<D>(u, n, vn, Scalar(1), compliance, m, restitution_threshold, jn);
   velocity += impulse;
   if (radius > 0) spin += detail::moment(r, impulse) * (inv_k / (radius * radius));
   if (m.rolling_resistance > 0) {

@@ -263,8 +263,8 @@ struct EvenDirections<2> {
 /// Biases that make the basins of the rest poses as large as the reference measured them
 /// (paper 3.4 made to keep the signature's frequencies). Pose i's basin is the set of body-frame
 /// up vectors u for which n_i . u + bias[i] is largest; with no biases these are the cells of
-/// plain nearest-pose choice, whose sizes follow only the geometry of the normals (for the bunny
-/// a pose seen in 5% of reference drops has 21% of all directions). The biases are chosen so
+/// plain nearest-pose choice, whose sizes follow only the geometry of the normals, so a pose the
+/// reference rarely ends in can own a large share of directions. The biases are chosen so
 /// that, for up vectors spread uniformly over the sphere (circle in 2D), each basin holds the
 /// pose's share of the table's frequencies. Of all partitions with those shares this one needs
 /// the smallest mean rotation (1 - cos of the angle): it is the optimal transport of uniform
@@ -273,7 +273,8 @@ struct EvenDirections<2> {
 /// settles, i.e. by its motion. Writes `sig.rest.count` values; all 0 without frequencies.
 ///
 /// Found by fixed-step ascent on the basin sizes over 2048 evenly spread directions (about 30
-/// iterations reach the lattice's resolution): under 10 ms for each committed table.
+/// iterations reach the lattice's resolution); the cost grows with the rest poses times the
+/// directions, once per shape (`add_shape`), never in a step.
 template <int D>
 void rest_basin_biases(const SignatureView<D>& sig, Scalar* bias)
 {

@@ -8,7 +8,7 @@
 namespace statsim {
 
 /// Outcome of a public call.
-enum class Status : std::uint8_t {
+enum class [[nodiscard]] Status : std::uint8_t {
   ok = 0,
   capacity_exceeded,     ///< the fixed pool is full: raise the world's template capacity
   non_finite,            ///< a position, velocity, mass, radius or gravity was NaN or infinite
@@ -57,7 +57,7 @@ enum Overflow : std::uint32_t {
 };
 
 /// What a call to `step()` did.
-struct StepResult {
+struct [[nodiscard]] StepResult {
   Status status = Status::ok;        ///< ok, or invalid_time_step (then nothing was stepped)
   std::uint32_t overflow = overflow_none;  ///< bit set of `Overflow`
   std::uint32_t pairs_found = 0;     ///< candidate pairs from the broad phase (incl. dropped)

@@ -3,6 +3,8 @@
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 
+#include <cstring>
+
 using namespace statsim;
 
 TEST_CASE("sphere-plane contact: normal is the planes - depth is the overlap")
@@ -136,4 +138,66 @@ TEST_CASE("particle response against a plane: restitution on the normal - fricti
   CHECK(particle_plane_response<3>(roll, wr, 0.5f, Vector3(0, 0, 1), m, 0.1f));
   CHECK(roll.x() == doctest::Approx(1.0 - 0.1 * 0.05));
   CHECK(wr.y() * 0.5f == doctest::Approx(roll.x()));
+}
+
+namespace {
+template <class T>
+bool same_bits(const T& x, const T& y)
+{
+  return std::memcmp(&x, &y, sizeof(T)) == 0;
+}
+
+/// particle_point_response against particle_response with both radii 0 on random contacts:
+/// velocities, spins, the result and the return value equal bit for bit.
+template <int D>
+void check_point_response_bits(std::uint64_t seed)
+{
+  using Vec = typename Space<D>::Vec;
+  using Spin = typename Space<D>::Spin;
+  Pcg32 g(seed, 3);
+  const auto vec = [&g](float s) {
+    Vec v;
+    for (int k = 0; k < D; ++k) v[k] = g.uniform(-s, s);
+    return v;
+  };
+  const auto spin = [&g]() {
+    if constexpr (D == 3) {
+      const float x = g.uniform(-9, 9), y = g.uniform(-9, 9), z = g.uniform(-9, 9);
+      return Spin(x, y, z);
+    } else {
+      return Spin(g.uniform(-9, 9));
+    }
+  };
+  int applied = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Vec va = vec(4), vb = vec(4);
+    Spin wa = spin(), wb = spin();
+    const Vec n = vec(1).normalized();
+    // Some sides static, some materials without friction or rolling resistance.
+    const Scalar ima = i % 7 == 0 ? Scalar(0) : g.uniform(0.01f, 3);
+    const Scalar imb = i % 11 == 0 ? Scalar(0) : g.uniform(0.01f, 3);
+    Material m;
+    m.restitution = g.uniform(0, 1);
+    m.friction = i % 5 == 0 ? Scalar(0) : g.uniform(0, 1.5f);
+    m.rolling_resistance = i % 3 == 0 ? Scalar(0) : g.uniform(0, 0.3f);
+    const Scalar threshold = g.uniform(0, 2);
+    Vec va2 = va, vb2 = vb;
+    Spin wa2 = wa, wb2 = wb;
+    const bool r1 = particle_response<D>({va, wa, ima, 0}, {vb, wb, imb, 0}, n, m, threshold);
+    const bool r2 = particle_point_response<D>({va2, wa2, ima, 0}, {vb2, wb2, imb, 0}, n, m, threshold);
+    REQUIRE(r1 == r2);
+    REQUIRE(same_bits(va, va2));
+    REQUIRE(same_bits(vb, vb2));
+    REQUIRE(same_bits(wa, wa2));
+    REQUIRE(same_bits(wb, wb2));
+    applied += r1;
+  }
+  CHECK(applied > 5000);  // the contacts do approach: the impulse path is exercised
+}
+}  // namespace
+
+TEST_CASE("particle_point_response is bit for bit particle_response with both radii 0 (2D and 3D)")
+{
+  check_point_response_bits<2>(41);
+  check_point_response_bits<3>(42);
 }

@@ -49,7 +49,7 @@ TEST_CASE("bad input is rejected with its status and the world is unchanged (3D)
 {
   World3<4, 2> w;
   fill_scene(w, 3, 1);
-  for (int i = 0; i < 10; ++i) w.step(1.0f / 60);
+  for (int i = 0; i < 10; ++i) REQUIRE(w.step(1.0f / 60).status == Status::ok);
   const std::uint64_t before = w.state_hash();
   const std::uint32_t bodies = w.body_count();
 
@@ -144,7 +144,7 @@ TEST_CASE("bad input is rejected with state unchanged (2D)")
 {
   World2<2, 1> w;
   fill_scene(w, 1, 2);
-  w.step(1.0f / 60);
+  REQUIRE(w.step(1.0f / 60).status == Status::ok);
   const std::uint64_t before = w.state_hash();
   BodyDef2 d;
   d.orientation = Rot2{0, 0};
@@ -183,7 +183,7 @@ TEST_CASE("a body dropped on the ground comes to rest at height r and falls asle
   CHECK(w3.body(0).linear_velocity.norm() == 0);
   // Asleep means asleep: more steps change nothing.
   const Vector3 rest = w3.body(0).position;
-  for (int i = 0; i < 100; ++i) w3.step(1.0f / 60);
+  for (int i = 0; i < 100; ++i) REQUIRE(w3.step(1.0f / 60).status == Status::ok);
   CHECK(w3.body(0).position == rest);
 
   World2<1, 1> w2;
@@ -192,7 +192,8 @@ TEST_CASE("a body dropped on the ground comes to rest at height r and falls asle
   b2.position = Vector2(0, 3);
   b2.angular_velocity = 2;
   REQUIRE(w2.add_body(b2).ok());
-  for (int i = 0; i < 60 * 10 && w2.body(0).state != MotionState::asleep; ++i) w2.step(1.0f / 60);
+  for (int i = 0; i < 60 * 10 && w2.body(0).state != MotionState::asleep; ++i)
+    REQUIRE(w2.step(1.0f / 60).status == Status::ok);
   CHECK(w2.body(0).state == MotionState::asleep);
   CHECK(w2.body(0).position.y() == doctest::Approx(-0.75).epsilon(1e-4));
 }

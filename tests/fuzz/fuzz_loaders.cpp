@@ -118,7 +118,7 @@ void fuzz_signature(Input& in)
     return;
   }
   using Vec = typename Space<D>::Vec;
-  world.add_plane(Vec::Unit(Space<D>::up_axis), 0);
+  if (!world.add_plane(Vec::Unit(Space<D>::up_axis), 0).ok()) fail("the ground plane was rejected");
   for (int i = 0; i < 8; ++i) {
     BodyDef<D> b;
     b.shape = shape.id;
@@ -131,7 +131,7 @@ void fuzz_signature(Input& in)
   }
   const bool ordinary_bodies = ordinary && !in.special();
   for (int s = 0; s < 60; ++s) {
-    world.step(1.0f / 60);
+    if (world.step(1.0f / 60).status != Status::ok) fail("a step with a valid dt was rejected");
     if (!ordinary_bodies) continue;
     for (std::uint32_t i = 0; i < world.body_count(); ++i) {
       const Body<D>& b = world.body(i);

@@ -102,7 +102,8 @@ public:
       throw std::runtime_error(std::string("statsim world: ") + to_string(world_->construction_status()));
     const Added<ShapeId> shape = world_->add_shape(sig);
     if (!shape.ok()) throw std::runtime_error(std::string("statsim add_shape: ") + to_string(shape.status));
-    world_->add_plane(Space<D>::Vec::Unit(Space<D>::up_axis), 0);
+    if (!world_->add_plane(Space<D>::Vec::Unit(Space<D>::up_axis), 0).ok())
+      throw std::runtime_error("statsim add_plane failed");
     for (const auto& s : scene.bodies) add_body<D>(*world_, shape.id, mass, s);
   }
   void step() override

@@ -183,7 +183,9 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
   if (shape.status != statsim::Status::ok) {
     throw std::runtime_error("statsim rejected the signature " + std::string(sig.name));
   }
-  world->add_plane(statsim::Vector2(0.0f, 1.0f), 0.0f);
+  if (!world->add_plane(statsim::Vector2(0.0f, 1.0f), 0.0f).ok()) {
+    throw std::runtime_error("statsim rejected the ground plane");
+  }
   for (const Body2State& s : init) {
     statsim::BodyDef2 b;
     b.position = statsim::Vector2(static_cast<float>(s.x), static_cast<float>(s.y));

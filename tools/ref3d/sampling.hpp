@@ -2,6 +2,8 @@
 // seeded from (seed, stream, index) only, so results do not depend on threads or order.
 #pragma once
 
+#include "statsim/random.hpp"  // mix64, the runtime's SplitMix64 finaliser
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -10,15 +12,6 @@
 #include <cstdint>
 
 namespace statsim::tools::ref3d {
-
-/// SplitMix64 finaliser: a 64-bit mixing function.
-inline std::uint64_t mix64(std::uint64_t x)
-{
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
 
 /// xoshiro256** seeded through SplitMix64 from (seed, stream, index).
 class TrialRng {

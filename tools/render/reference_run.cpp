@@ -87,9 +87,13 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
   if (o.engine == "statsim") {
     WorldDef3 def;
     def.seed = o.seed;
-    g_world.configure(def);
-    const ShapeId shape = g_world.add_shape(sig).id;
-    g_world.add_plane(Vector3(0, 0, 1), 0);
+    const Status configured = g_world.configure(def);
+    const Added<ShapeId> added = g_world.add_shape(sig);
+    if (configured != Status::ok || !added.ok() || !g_world.add_plane(Vector3(0, 0, 1), 0).ok()) {
+      error = "statsim world set-up failed";
+      return false;
+    }
+    const ShapeId shape = added.id;
     for (const scenes::BodyState3& s : scene.bodies) {
       BodyDef3 b;
       b.position = s.position.cast<Scalar>();
@@ -104,7 +108,10 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
       }
     }
     for (int s = 0; s < steps; ++s) {
-      g_world.step(Scalar(dt));
+      if (g_world.step(Scalar(dt)).status != Status::ok) {
+        error = "statsim step failed";
+        return false;
+      }
       if (s % o.every != 0) continue;
       for (std::uint32_t i = 0; i < g_world.body_count(); ++i) {
         const Body3& b = g_world.body(i);

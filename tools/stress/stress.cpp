@@ -309,7 +309,7 @@ public:
     world_ = std::make_unique<World2<256, 4, 256 * 16, 2>>();
     const SignatureView<2> sig = tables::square2d.view();
     const auto shape = world_->add_shape(sig);
-    world_->add_plane(Vector2(0, 1), 0);
+    if (!shape.ok() || !world_->add_plane(Vector2(0, 1), 0).ok()) throw std::runtime_error("statsim 2D set-up failed");
     for (const auto& s : states) {
       BodyDef<2> b;
       b.position = s.position.cast<Scalar>();
@@ -321,7 +321,10 @@ public:
       if (!world_->add_body(b).ok()) throw std::runtime_error("statsim 2D add_body failed");
     }
   }
-  void step(double dt) override { world_->step(static_cast<Scalar>(dt)); }
+  void step(double dt) override
+  {
+    if (world_->step(static_cast<Scalar>(dt)).status != Status::ok) throw std::runtime_error("statsim 2D step failed");
+  }
   std::size_t size() const override { return world_->body_count(); }
   State2 state(std::size_t i) const override
   {
@@ -871,14 +874,14 @@ void bad_input_dim(Matrix& mx, const SignatureView<D>& sig, const char* method)
   const Scalar nan = std::numeric_limits<Scalar>::quiet_NaN(), inf = std::numeric_limits<Scalar>::infinity();
   const auto make = [&sig](World<D, 4, 2, 16, 2>& w) {
     const auto shape = w.add_shape(sig);
-    w.add_plane(Vec::Unit(Space<D>::up_axis), 0);
+    bool set_up = shape.ok() && w.add_plane(Vec::Unit(Space<D>::up_axis), 0).ok();
     for (int i = 0; i < 3; ++i) {
       BodyDef<D> b;
       b.shape = shape.id;
       b.position = Vec::Unit(Space<D>::up_axis) * Scalar(1 + i);
-      w.add_body(b);
+      set_up = set_up && w.add_body(b).ok();
     }
-    w.step(Scalar(1) / 60);
+    if (!set_up || w.step(Scalar(1) / 60).status != Status::ok) throw std::runtime_error("bad input: scene set-up failed");
   };
   Rot zero_q, long_q;
   if constexpr (D == 3) {
@@ -918,7 +921,7 @@ void bad_input_dim(Matrix& mx, const SignatureView<D>& sig, const char* method)
        [](World<D, 4, 2, 16, 2>& w) {
          BodyDef<D> b;
          b.position = Vec::Unit(Space<D>::up_axis) * Scalar(5);
-         w.add_body(b);  // the 4th body fills the pool (not checked: it is a valid call)
+         (void)w.add_body(b);  // the 4th body fills the pool; the call under test is the next one
          return w.add_body(b).status;
        }},
       {"zero dt", Status::invalid_time_step, [](World<D, 4, 2, 16, 2>& w) { return w.step(0).status; }},
@@ -948,7 +951,7 @@ void bad_input_dim(Matrix& mx, const SignatureView<D>& sig, const char* method)
     if (std::string(c.name) == "adding past capacity") {
       BodyDef<D> b;
       b.position = Vec::Unit(Space<D>::up_axis) * Scalar(5);
-      w->add_body(b);
+      (void)w->add_body(b);  // fills the pool; the call under test is the next one
       before = w->state_hash();
       bodies = w->body_count();
       BodyDef<D> b2 = b;

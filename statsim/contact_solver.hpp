@@ -1,0 +1,337 @@
+#pragma once
+/// @file
+/// The contact solver: the passes of a step over the contacts of bodies with planes and with
+/// each other, one function per pass over two shared contact loops.
+///
+/// The impact pass resolves impacts with the bodies' responses: statistical bodies get the
+/// statistical response (paper 3.3.2), plain spheres the particle response. Support passes only
+/// take out what approach velocity is left (inelastic, with friction), so that a stack passes its
+/// weight down to the ground within one step instead of one layer per step.
+///
+/// The shock pass (Guendelman, Bridson and Fedkiw 2003) then visits contacts from the bottom up
+/// and treats the lower body of each as immovable: whatever approach velocity and overlap are
+/// left go to the upper body alone, so a pile is consistent from the ground up after one pass,
+/// where Gauss-Seidel passes over k layers leave residuals that pump the pile.
+///
+/// Position passes repeat only the shock pass's overlap correction. One pass leaves a body
+/// wedged between several others (or between a sleeper and the ground) where the last push put
+/// it, which may be back inside the first; a few repetitions let it find the gap, without
+/// touching velocities.
+///
+/// Overlaps between bodies are corrected once per step: in the shock pass, or in the impact pass
+/// without one. Pushing overlaps apart in every pass, split between both bodies, squeezes bodies
+/// sideways and upward out of a packed pile each step, and the lift comes back as kinetic
+/// energy, so the pile never sleeps.
+
+#include "statsim/world_data.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <utility>
+
+namespace statsim {
+namespace detail {
+
+/// Approach speed used as restitution threshold after the impact pass: nothing bounces there.
+constexpr Scalar no_bounce = std::numeric_limits<Scalar>::infinity();
+/// Passes after the impact pass count spheres within this fraction of their radius as touching:
+/// the impact pass leaves resting contacts exactly touching, not overlapping.
+constexpr Scalar contact_slop = Scalar(1e-3);
+
+/// The response of one body alone against a plane with normal `n` (towards the body), with
+/// its velocity taken relative to `other_velocity`: the statistical response for statistical
+/// shapes (paper 3.3.2; for body-body contacts each body responds on its own, as in the
+/// paper), the rest turn for bodies settling on the ground (paper 3.4), else (plain spheres,
+/// and resting contacts of statistical bodies) the particle response against a static plane.
+template <int D>
+void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const typename Space<D>::Vec& n,
+                   const typename Space<D>::Vec& other_velocity, bool ground_contact)
+{
+  using Vec = typename Space<D>::Vec;
+  const Shape<D>& shape = w.shapes[b.shape];
+  const WorldDef<D>& def = w.def;
+  Vec v = b.linear_velocity - other_velocity;
+  // A contact approaching slower than the restitution threshold is resting, not a collision:
+  // the tables describe collisions, and sampling a fresh spin at every resting step would
+  // keep a body from ever settling. It gets the inelastic particle response instead.
+  const bool resting = -v.dot(n) <= def.restitution_threshold;
+  if (!shape.statistical || (resting && !(ground_contact && b.rest_pose != no_rest_pose))) {
+    particle_plane_response<D>(v, b.angular_velocity, contact_radius(w, b), n, shape.material,
+                               def.restitution_threshold);
+  } else if (ground_contact && b.rest_pose != no_rest_pose) {
+    if (!(v.dot(n) < 0)) return;
+    v = point_particle_velocity<D>(v, n, shape.material, def.restitution_threshold);
+    b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, def.rest_turn_time);
+    // A small turn (paper 3.4): its farthest point moves at most at the settle speed, so a
+    // slow body is not spun up (sin(angle) / rest_turn_time alone reaches 10 rad/s).
+    const Scalar cap = def.settle_speed / b.bounding_radius;
+    const Scalar spin2 = squared_norm(b.angular_velocity);
+    if (spin2 > cap * cap) b.angular_velocity = b.angular_velocity * (cap / std::sqrt(spin2));
+  } else {
+    Pcg32 rng = rng_of(w, b);
+    const ResponseOutcome o = statistical_response<D>(shape.signature, b.orientation, n, v, b.angular_velocity, rng);
+    b.rng_state = rng.state();
+    ctx.energy_clamps += o.energy_clamped;
+  }
+  b.linear_velocity = v + other_velocity;
+}
+
+/// Body-body impact with at least one statistical body. Each body first responds on its own
+/// to the separating plane with its velocity relative to the other's (paper 3.3.2), from the
+/// velocities before either response; a sleeper (inverse mass 0) keeps still.
+/// `PairResponse::independent` keeps those velocities, as the paper does. With
+/// `PairResponse::momentum` the two changes of relative velocity are averaged into one impulse
+/// that each body takes in proportion to its inverse mass, so momentum is conserved and the
+/// pair's kinetic energy in its centre-of-mass frame cannot grow; spins stay as sampled.
+template <int D>
+void respond_pair(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D>& b, const typename Space<D>::Vec& n,
+                  Scalar ima, Scalar imb)
+{
+  using Vec = typename Space<D>::Vec;
+  const Vec va = a.linear_velocity, vb = b.linear_velocity;
+  if (ima > 0) respond_alone(w, ctx, a, -n, vb, false);
+  if (imb > 0) respond_alone(w, ctx, b, n, va, false);
+  if (w.def.pair_response != PairResponse::momentum) return;
+  // Change of (vb - va) as each body saw it; a static side saw none, so the other counts alone.
+  const Vec from_b = (b.linear_velocity - va) - (vb - va);
+  const Vec from_a = (vb - a.linear_velocity) - (vb - va);
+  const Vec change = ima > 0 && imb > 0 ? Vec((from_a + from_b) * Scalar(0.5)) : (ima > 0 ? from_a : from_b);
+  const Scalar ims = ima + imb;
+  a.linear_velocity = va - change * (ima / ims);
+  b.linear_velocity = vb + change * (imb / ims);
+}
+
+/// The particle response of two bodies (`particle_point_response` when neither has a lever
+/// arm, the same rule without the terms that vanish). True when an impulse was applied.
+template <int D>
+bool particle_pair(const WorldData<D>& w, Body<D>& a, Body<D>& b, const typename Space<D>::Vec& n, Scalar ima,
+                   Scalar imb, Scalar threshold)
+{
+  const Scalar ra = contact_radius(w, a), rb = contact_radius(w, b);
+  // Bodies of one shape need no mixed material: sqrt(f * f) == f in IEEE arithmetic.
+  const Material m = a.shape == b.shape ? w.shapes[a.shape].material
+                                        : mix(w.shapes[a.shape].material, w.shapes[b.shape].material);
+  const ContactSide<D> sa{a.linear_velocity, a.angular_velocity, ima, ra};
+  const ContactSide<D> sb{b.linear_velocity, b.angular_velocity, imb, rb};
+  return ra == 0 && rb == 0 ? particle_point_response<D>(sa, sb, n, m, threshold)
+                            : particle_response<D>(sa, sb, n, m, threshold);
+}
+
+/// Inverse masses of a touching pair: 0 for a sleeper. In the bottom-up passes (shock and
+/// position) a contact that mostly supports (normal within 60 degrees of up) also freezes its
+/// lower body; the normal points from a to b, so n_up > 0 means a is below. Returns their sum.
+template <int D>
+Scalar inverse_masses(const Body<D>& a, const Body<D>& b, const typename Space<D>::Vec& n, bool bottom_up,
+                      Scalar& ima, Scalar& imb)
+{
+  const int up = Space<D>::up_axis;
+  ima = a.state == MotionState::asleep ? 0 : a.inv_mass;
+  imb = b.state == MotionState::asleep ? 0 : b.inv_mass;
+  if (bottom_up && n[up] >= Scalar(0.5) && imb > 0) ima = 0;
+  if (bottom_up && n[up] <= Scalar(-0.5) && ima > 0) imb = 0;
+  return ima + imb;
+}
+
+/// Pushes two bodies apart by the part of their overlap beyond `WorldDef::allowed_overlap`,
+/// times `overlap_correction`, split in proportion to inverse mass (in the bottom-up passes the
+/// lower body's is 0), so a sleeper does not move.
+template <int D>
+void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D>& b, const Contact<D>& c,
+                     Scalar slop, Scalar ima, Scalar imb, Scalar ims)
+{
+  const Scalar depth = (c.depth - slop - w.def.allowed_overlap * (a.radius + b.radius)) * w.def.overlap_correction;
+  if (!(depth > 0)) return;
+  a.position -= c.normal * (depth * ima / ims);
+  b.position += c.normal * (depth * imb / ims);
+  ++ctx.moves;
+}
+
+/// The shared loop over plane contacts: for every awake body and plane that touch (spheres grown
+/// by `contact_slop` when `grown`), moves the body out of the plane, marks it touching (and on
+/// the ground for a near-horizontal plane), then calls `respond(body, contact, ground)`.
+/// Returns the number of contacts.
+template <int D, class Respond>
+std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Respond&& respond)
+{
+  std::uint32_t contacts = 0;
+  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+    Body<D>& b = w.bodies[i];
+    if (b.state == MotionState::asleep) continue;
+    for (std::uint32_t p = 0; p < w.plane_count; ++p) {
+      Contact<D> c;
+      // Passes after the impact pass also see a body that the last pass left exactly touching.
+      const Scalar slop = grown ? b.radius * contact_slop : Scalar(0);
+      if (!sphere_plane_contact<D>(b.position, b.radius + slop, w.planes[p], c)) continue;
+      if (c.depth > slop) {
+        b.position += c.normal * (c.depth - slop);
+        ++ctx.moves;
+        ++ctx.changes;
+      }
+      b.touching = true;
+      const bool ground = c.normal[Space<D>::up_axis] >= w.def.ground_cosine;
+      b.on_ground = b.on_ground || ground;
+      ++contacts;
+      respond(b, c, ground);
+    }
+  }
+  return contacts;
+}
+
+/// The shared loop over body-body contacts among the first `count` candidate pairs (spheres
+/// grown by `contact_slop` of their radii's sum when `grown`). For each touching pair it calls
+/// `resolve(a, b, contact, slop)`, which returns false when neither body can move, and else
+/// marks both touching. With `compact`, touching pairs move to the front of the buffer, in their
+/// order. Returns the number of touching pairs.
+template <int D, class Resolve>
+std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bool compact, Resolve&& resolve)
+{
+  std::uint32_t touching = 0;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    Body<D>& a = w.bodies[w.pairs[k].a];
+    Body<D>& b = w.bodies[w.pairs[k].b];
+    Contact<D> c;
+    const Scalar slop = grown ? (a.radius + b.radius) * contact_slop : Scalar(0);
+    if (!sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c)) continue;
+    if (compact) std::swap(w.pairs[touching], w.pairs[k]);
+    ++touching;
+    if (!resolve(a, b, c, slop)) continue;
+    a.touching = true;
+    b.touching = true;
+  }
+  return touching;
+}
+
+/// Clears every body's contact flags: the passes of this step set them again.
+template <int D>
+void forget_contacts(WorldData<D>& w)
+{
+  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+    w.bodies[i].touching = false;
+    w.bodies[i].on_ground = false;
+  }
+}
+
+/// The plane contacts of a support pass (and of the shock pass): inelastic particle responses.
+template <int D>
+void support_planes(WorldData<D>& w, StepContext& ctx)
+{
+  plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool) {
+    if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
+                                   w.shapes[b.shape].material, no_bounce))
+      ++ctx.changes;
+  });
+}
+
+/// The impact pass: planes, then pairs, each with the bodies' own response; awake bodies that hit
+/// a sleeper faster than `wake_speed` wake it. Leaves the touching pairs at the front of the pair
+/// buffer and their number in `ctx.touching`. Returns the number of contacts.
+template <int D>
+std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
+{
+  using Vec = typename Space<D>::Vec;
+  const WorldDef<D>& def = w.def;
+  const std::uint32_t plane_count = plane_contacts(w, ctx, false, [&](Body<D>& b, const Contact<D>& c, bool ground) {
+    if (w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground);
+    else if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
+                                        w.shapes[b.shape].material, def.restitution_threshold))
+      ++ctx.changes;
+  });
+  ctx.touching = pair_contacts(w, w.pair_count, false, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c,
+                                                                 Scalar slop) {
+    const Vec& n = c.normal;
+    const bool a_asleep = a.state == MotionState::asleep;
+    const bool b_asleep = b.state == MotionState::asleep;
+    if (a_asleep || b_asleep) {
+      // An awake body hitting a sleeper fast enough wakes it; otherwise the sleeper is static.
+      const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(n);
+      if (approach > def.wake_speed) {
+        if (a_asleep) wake(a);
+        if (b_asleep) wake(b);
+      }
+    }
+    Scalar ima, imb;
+    const Scalar ims = inverse_masses(a, b, n, false, ima, imb);
+    if (ims <= 0) return false;
+    if (w.shapes[a.shape].statistical || w.shapes[b.shape].statistical) respond_pair(w, ctx, a, b, n, ima, imb);
+    else if (particle_pair(w, a, b, n, ima, imb, def.restitution_threshold)) ++ctx.changes;
+    if (!def.shock_propagation) correct_overlap(w, ctx, a, b, c, slop, ima, imb, ims);
+    return true;
+  });
+  return plane_count + ctx.touching;
+}
+
+/// A support pass over the touching pairs, then the planes: inelastic particle responses, planes
+/// last, since a pair push can drive a body into the ground and the ground has the last word on
+/// position and velocity. Returns the number of impulses and position corrections.
+template <int D>
+std::uint32_t support_pass(WorldData<D>& w, StepContext& ctx)
+{
+  ctx.changes = 0;
+  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar) {
+    Scalar ima, imb;
+    if (inverse_masses(a, b, c.normal, false, ima, imb) <= 0) return false;
+    if (particle_pair(w, a, b, c.normal, ima, imb, no_bounce)) ++ctx.changes;
+    return true;
+  });
+  support_planes(w, ctx);
+  return ctx.changes;
+}
+
+/// Orders the first `count` pairs by the height of their lower centre, ties by body index, so
+/// the order is a total one and the same on every platform.
+template <int D>
+void sort_bottom_up(WorldData<D>& w, std::uint32_t count)
+{
+  const int up = Space<D>::up_axis;
+  const Body<D>* bodies = w.bodies;
+  std::sort(w.pairs, w.pairs + count, [bodies, up](const Pair& x, const Pair& y) {
+    const Scalar xa = bodies[x.a].position[up], xb = bodies[x.b].position[up];
+    const Scalar ya = bodies[y.a].position[up], yb = bodies[y.b].position[up];
+    const Scalar kx = xa < xb ? xa : xb, ky = ya < yb ? ya : yb;
+    if (kx != ky) return kx < ky;
+    if (x.a != y.a) return x.a < y.a;
+    return x.b < y.b;
+  });
+}
+
+/// The shock pass: the touching pairs from the bottom up, lower bodies frozen, inelastic
+/// responses and the step's overlap correction; then the planes as in a support pass. Returns
+/// the number of position corrections.
+template <int D>
+std::uint32_t shock_pass(WorldData<D>& w, StepContext& ctx)
+{
+  sort_bottom_up(w, ctx.touching);
+  ctx.moves = 0;
+  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop) {
+    Scalar ima, imb;
+    const Scalar ims = inverse_masses(a, b, c.normal, true, ima, imb);
+    if (ims <= 0) return false;
+    if (particle_pair(w, a, b, c.normal, ima, imb, no_bounce)) ++ctx.changes;
+    correct_overlap(w, ctx, a, b, c, slop, ima, imb, ims);
+    return true;
+  });
+  support_planes(w, ctx);
+  return ctx.moves;
+}
+
+/// A position pass: the shock pass's overlap correction alone, in its order and with its frozen
+/// bodies, then bodies moved out of planes; velocities are left as the passes before settled
+/// them. Returns the number of position corrections.
+template <int D>
+std::uint32_t position_pass(WorldData<D>& w, StepContext& ctx)
+{
+  ctx.moves = 0;
+  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop) {
+    Scalar ima, imb;
+    const Scalar ims = inverse_masses(a, b, c.normal, true, ima, imb);
+    if (ims <= 0) return false;
+    correct_overlap(w, ctx, a, b, c, slop, ima, imb, ims);
+    return true;
+  });
+  plane_contacts(w, ctx, true, [](Body<D>&, const Contact<D>&, bool) {});
+  return ctx.moves;
+}
+
+}  // namespace detail
+}  // namespace statsim

@@ -1,0 +1,145 @@
+#pragma once
+/// @file
+/// Collision radius, rest and sleep: the statistical bodies' radius at the start of a step
+/// (paper 3.3.1), and at its end the resting conditions (paper 3.4) and the motion states
+/// (moving, settling, asleep).
+
+#include "statsim/world_data.hpp"
+
+#include <cstdint>
+
+namespace statsim {
+namespace detail {
+
+/// Collision radius of statistical bodies (paper 3.3.1), blended toward the rest height of a
+/// chosen rest pose (paper 3.4).
+template <int D>
+void update_radii(WorldData<D>& w)
+{
+  using Vec = typename Space<D>::Vec;
+  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+    Body<D>& b = w.bodies[i];
+    const Shape<D>& shape = w.shapes[b.shape];
+    if (!shape.statistical || b.state == MotionState::asleep) continue;
+    const SignatureView<D>& sig = shape.signature;
+    // Spin ratio with the speed floored: a body bouncing in place has |v| near 0 one step and
+    // g dt the next, and |w| L / |v| would swing its radius between the table's ends.
+    const Scalar speed = b.linear_velocity.norm();
+    const Scalar floor = w.def.spin_ratio_speed_floor;
+    const Vec v_ref = speed < floor ? Vec(Vec::Unit(0) * floor) : Vec(b.linear_velocity);
+    const Scalar r = collision_radius<D>(sig, v_ref, b.angular_velocity, w.def.nearest_radius);
+    if (b.rest_pose == no_rest_pose && !b.pile_rest) {
+      b.radius = r;
+      continue;
+    }
+    const Scalar h = b.rest_pose != no_rest_pose ? sig.rest.heights[b.rest_pose] : shape.mean_rest_height;
+    const Scalar blended = r + (h - r) * b.rest_blend;
+    // A settling body's sphere changes size about its lowest point, so a body blending to its
+    // rest height settles smoothly instead of dropping (paper 3.4).
+    if (b.on_ground || b.pile_rest) b.position[Space<D>::up_axis] += blended - b.radius;
+    b.radius = blended;
+  }
+}
+
+/// Resting conditions (paper 3.4): a statistical body settling on the ground picks the rest
+/// pose nearest to its orientation and blends its radius toward that pose's height; a body
+/// that speeds up again blends back and forgets the pose; a body briefly off the ground keeps
+/// it.
+template <int D>
+void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground, bool settling_on_bodies, bool fast,
+                      Scalar dt)
+{
+  using Vec = typename Space<D>::Vec;
+  const Shape<D>& shape = w.shapes[b.shape];
+  const WorldDef<D>& def = w.def;
+  if (!shape.statistical || !def.rest_conditions || shape.signature.rest.count == 0) return;
+  const Scalar step = dt / def.rest_blend_time;
+  if (settling_on_ground) {
+    if (b.rest_pose == no_rest_pose) {
+      const std::uint32_t pose =
+          nearest_rest_pose<D>(shape.signature, b.orientation, Vec::Unit(Space<D>::up_axis), shape.rest_bias.data());
+      if (pose >= shape.signature.rest.count) return;  // only with a non-finite orientation
+      b.rest_pose = std::uint8_t(pose);
+    }
+    b.pile_rest = false;
+    b.rest_blend = b.rest_blend + step < 1 ? b.rest_blend + step : Scalar(1);
+  } else if (def.pile_rest && settling_on_bodies && (b.pile_rest || b.rest_pose == no_rest_pose)) {
+    b.pile_rest = true;
+    b.rest_blend = b.rest_blend + step < 1 ? b.rest_blend + step : Scalar(1);
+  } else if (fast && (b.rest_pose != no_rest_pose || b.pile_rest)) {
+    b.rest_blend = b.rest_blend - step > 0 ? b.rest_blend - step : Scalar(0);
+    if (b.rest_blend == 0) {
+      b.rest_pose = no_rest_pose;
+      b.pile_rest = false;
+    }
+  }
+}
+
+/// True when the chosen rest pose's normal is within `rest_snap_cosine` of up.
+template <int D>
+bool in_rest_pose(const WorldData<D>& w, const Body<D>& b)
+{
+  const SignatureView<D>& sig = w.shapes[b.shape].signature;
+  const typename Space<D>::Vec u = b.orientation * sig.rest.normal(b.rest_pose);
+  return u[Space<D>::up_axis] >= w.def.rest_snap_cosine;
+}
+
+/// The last phase of a step: each awake body is moving, settling (touching and slower than
+/// `settle_speed`) or, once still for `sleep_time`, asleep; settling bodies follow the resting
+/// conditions.
+template <int D>
+void update_motion_states(WorldData<D>& w, Scalar dt)
+{
+  using Vec = typename Space<D>::Vec;
+  const WorldDef<D>& def = w.def;
+  const Scalar settle2 = def.settle_speed * def.settle_speed;
+  const Scalar sleep2 = def.sleep_speed * def.sleep_speed;
+  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+    Body<D>& b = w.bodies[i];
+    if (b.state == MotionState::asleep) continue;
+    const Scalar r2 = b.bounding_radius * b.bounding_radius;
+    const Scalar v2 = b.linear_velocity.squaredNorm();
+    // A body turning into its rest pose spins because the resting conditions make it: its
+    // spin does not count against settling, and it sleeps once the pose is (nearly) reached.
+    const bool turning = b.rest_pose != no_rest_pose;
+    const Scalar w2 = turning ? Scalar(0) : squared_norm(b.angular_velocity) * r2;
+    const Scalar speed2 = v2 > w2 ? v2 : w2;
+    const bool settling = b.touching && speed2 < settle2;
+    update_rest_pose(w, b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt);
+    if (!settling) {
+      b.state = MotionState::moving;
+      b.slow_time = 0;
+      continue;
+    }
+    b.state = MotionState::settling;
+    // Stillness by displacement as well as velocity: with three or more contacts the passes
+    // can leave a velocity that separates from some while sliding along another; the next
+    // step moves the body into them and the shock pass moves it back, a cycle in which it
+    // never moves and never sleeps (tools/ref2d/README.md shows how often in a pile).
+    const Scalar moved2 = (b.position - b.step_start).squaredNorm();
+    const Scalar lin2 = moved2 < v2 * dt * dt ? moved2 / (dt * dt) : v2;
+    // It turns at ground contacts only: one that keeps its pose while held up by other bodies
+    // cannot reach it there, and may sleep where it is.
+    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (!turning || !b.on_ground || in_rest_pose(w, b));
+    b.slow_time = still ? b.slow_time + dt : 0;
+    if (still && b.slow_time >= def.sleep_time) {
+      b.state = MotionState::asleep;
+      b.linear_velocity = Vec::Zero();
+      b.angular_velocity = Space<D>::zero_spin();
+      if (b.rest_pose != no_rest_pose && b.on_ground) {
+        // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
+        // the radius blend are below what a slow body would show.
+        const SignatureView<D>& sig = w.shapes[b.shape].signature;
+        const Vec up = Vec::Unit(Space<D>::up_axis);
+        b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), up);
+        const Scalar h = sig.rest.heights[b.rest_pose];
+        b.position[Space<D>::up_axis] += h - b.radius;
+        b.radius = h;
+        b.rest_blend = 1;
+      }
+    }
+  }
+}
+
+}  // namespace detail
+}  // namespace statsim

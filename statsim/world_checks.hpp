@@ -1,0 +1,156 @@
+#pragma once
+/// @file
+/// Checks of everything a user hands to a world: world parameters, shapes, body states and
+/// signatures. Each returns the first problem it finds as a `Status`, so that a rejected call
+/// can return before it changes anything.
+
+#include "statsim/world_def.hpp"
+
+#include <cstdint>
+
+namespace statsim {
+namespace detail {
+
+/// The parameters of a world: `non_finite` for a NaN or infinity, `invalid_parameter` for a
+/// value outside its documented range.
+template <int D>
+Status check_world_def(const WorldDef<D>& d)
+{
+  if (!finite(d.gravity) || !finite(d.restitution_threshold) || !finite(d.settle_speed) || !finite(d.sleep_speed) ||
+      !finite(d.sleep_time) || !finite(d.wake_speed) || !finite(d.linear_damping) || !finite(d.angular_damping) ||
+      !finite(d.allowed_overlap) || !finite(d.overlap_correction) || !finite(d.rest_blend_time) ||
+      !finite(d.rest_turn_time) || !finite(d.ground_cosine) || !finite(d.rest_snap_cosine) ||
+      !finite(d.spin_ratio_speed_floor))
+    return Status::non_finite;
+  if (d.restitution_threshold < 0 || d.settle_speed < 0 || d.sleep_speed < 0 || d.sleep_time < 0 ||
+      d.wake_speed < 0 || d.linear_damping < 0 || d.angular_damping < 0 || d.support_iterations < 1 ||
+      d.support_iterations > 64 || d.position_iterations < 0 || d.position_iterations > 64 ||
+      (d.broad_phase != BroadPhase::grid && d.broad_phase != BroadPhase::sweep_and_prune &&
+       d.broad_phase != BroadPhase::automatic) || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
+      !(d.overlap_correction > 0) || d.overlap_correction > 1 || !(d.rest_blend_time > 0) ||
+      !(d.rest_turn_time > 0) || d.ground_cosine < 0 || d.ground_cosine > 1 || d.rest_snap_cosine < 0 ||
+      d.rest_snap_cosine > 1 || d.spin_ratio_speed_floor < 0 || d.sweep_axis < 0 || d.sweep_axis >= D ||
+      !within(d.gravity, limits::gravity) || d.rest_turn_time < Scalar(1e-4))
+    return Status::invalid_parameter;
+  return Status::ok;
+}
+
+/// A plain sphere shape, whose bounding radius (0 meaning "the radius") is `bound`.
+inline Status check_shape_def(const ShapeDef& def, Scalar bound)
+{
+  if (!finite(def.radius) || !finite(bound) || !finite(def.material.restitution) ||
+      !finite(def.material.friction))
+    return Status::non_finite;
+  if (!(def.radius > 0) || bound < def.radius) return Status::invalid_radius;
+  if (def.radius < limits::min_radius || bound > limits::max_radius) return Status::out_of_range;
+  if (!finite(def.material.rolling_resistance)) return Status::non_finite;
+  if (def.material.restitution < 0 || def.material.restitution > 1 || def.material.friction < 0 ||
+      def.material.rolling_resistance < 0)
+    return Status::invalid_material;
+  return Status::ok;
+}
+
+/// A body's position, orientation and velocities.
+template <int D>
+Status check_state(const typename Space<D>::Vec& x, const typename Space<D>::Rot& q, const typename Space<D>::Vec& v,
+                   const typename Space<D>::Spin& w)
+{
+  if (!finite(x) || !finite(q) || !finite(v) || !finite(w)) return Status::non_finite;
+  const Scalar n2 = squared_norm(q);
+  if (!(n2 > Scalar(1e-12))) return Status::zero_quaternion;
+  // |q|^2 - 1 ~ 2 (|q| - 1): a tolerance of 1e-3 on the length.
+  if (!(n2 > Scalar(1 - 2e-3) && n2 < Scalar(1 + 2e-3))) return Status::non_unit_quaternion;
+  if (!within(x, limits::coordinate) || !within(v, limits::speed) || !within(w, limits::spin))
+    return Status::out_of_range;
+  return Status::ok;
+}
+
+/// True when a table's numbers can be read: float or 16-bit storage is present.
+inline bool readable(const ValuesView& v) { return v.f32 != nullptr || v.i16 != nullptr; }
+/// True when an axis has a sample and its values can be read.
+inline bool readable(const AxisView& a) { return a.values != nullptr && a.size >= 1; }
+
+/// The layout of a signature: every pointer the world will read is present, for every count
+/// above 0, and the counts fit the runtime. The values are checked by `check_signature_values`.
+template <int D>
+Status check_signature_layout(const SignatureView<D>& sig)
+{
+  const HeightTableView& h = sig.height;
+  if (!readable(h.spin_ratio) || !readable(h.mean) || !readable(h.stddev)) return Status::invalid_shape;
+  const ResponseTableView& r = sig.response;
+  const std::uint32_t expected_axes = (D == 3 ? 3u : 2u) + (sig.layout == ResponseLayout::with_speed ? 1u : 0u);
+  if (r.axis_count != expected_axes || r.components != (D == 3 ? 6u : 3u)) return Status::invalid_shape;
+  // Cells times components must fit the 32-bit offsets of `ResponseTableView::lookup`.
+  std::uint64_t values = r.components;
+  for (std::uint32_t a = 0; a < r.axis_count; ++a) {
+    if (!readable(r.axes[a])) return Status::invalid_shape;
+    values *= r.axes[a].size;
+    if (values > 0x7fffffffu) return Status::invalid_shape;
+  }
+  if (!readable(r.mean) || !readable(r.stddev)) return Status::invalid_shape;
+  const RestPosesView<D>& rest = sig.rest;
+  if (rest.count > max_rest_poses) return Status::invalid_shape;
+  if (rest.count > 0 && (rest.normals == nullptr || rest.heights == nullptr || rest.frequencies == nullptr))
+    return Status::invalid_shape;
+  return Status::ok;
+}
+
+/// The numbers of a signature: every one finite, axes strictly increasing, heights positive,
+/// rest normals unit, rest frequencies in [0, 1]. Table values are bounded (|x| <= 1e6:
+/// normalised responses are O(1)) so that scaling them by a speed cannot overflow. One pass over
+/// the tables, at add_shape only; the layout must have passed `check_signature_layout`.
+template <int D>
+Status check_signature_values(const SignatureView<D>& sig)
+{
+  constexpr Scalar bound = Scalar(1e6);
+  const auto bad = [bound](Scalar x) { return !(x >= -bound && x <= bound); };  // NaN is bad
+  const auto bad_axis = [&bad](const AxisView& a) {
+    for (std::uint32_t i = 0; i < a.size; ++i)
+      if (bad(a.values[i]) || (i > 0 && !(a.values[i] > a.values[i - 1]))) return true;
+    return false;
+  };
+  const Material& m = sig.material;
+  if (bad(m.restitution) || bad(m.friction) || bad(m.rolling_resistance) || bad(sig.restitution_threshold) ||
+      bad(sig.mass) || bad(sig.unit_inertia[0]) || bad(sig.unit_inertia[1]) || bad(sig.unit_inertia[2]))
+    return Status::non_finite;
+  if (m.rolling_resistance < 0 || sig.restitution_threshold < 0) return Status::invalid_material;
+  if (sig.unit_inertia[0] < 0 || sig.unit_inertia[1] < 0 || sig.unit_inertia[2] < 0) return Status::invalid_shape;
+  const HeightTableView& h = sig.height;
+  if (bad_axis(h.spin_ratio)) return Status::invalid_shape;
+  for (std::uint32_t i = 0; i < h.spin_ratio.size; ++i)
+    if (bad(h.mean[i]) || !(h.mean[i] > 0) || bad(h.stddev[i])) return Status::invalid_shape;
+  const ResponseTableView& r = sig.response;
+  std::uint32_t values = r.components;
+  for (std::uint32_t a = 0; a < r.axis_count; ++a) {
+    if (bad_axis(r.axes[a])) return Status::invalid_shape;
+    values *= r.axes[a].size;
+  }
+  if (bad(r.mean.scale) || bad(r.mean.offset) || bad(r.stddev.scale) || bad(r.stddev.offset))
+    return Status::invalid_shape;
+  for (std::uint32_t i = 0; i < values; ++i)
+    if (bad(r.mean[i]) || bad(r.stddev[i])) return Status::invalid_shape;
+  for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+    const typename Space<D>::Vec n = sig.rest.normal(i);
+    if (!finite(n) || !(std::fabs(n.squaredNorm() - 1) < Scalar(2e-3))) return Status::invalid_shape;
+    if (bad(sig.rest.heights[i]) || !(sig.rest.heights[i] > 0)) return Status::invalid_shape;
+    const Scalar f = sig.rest.frequencies[i];
+    if (!(f >= 0 && f <= 1)) return Status::invalid_shape;  // NaN fails too
+  }
+  return Status::ok;
+}
+
+/// A whole signature: its scalars, its layout, then its values.
+template <int D>
+Status check_signature(const SignatureView<D>& sig)
+{
+  if (!finite(sig.length) || !finite(sig.bounding_radius)) return Status::non_finite;
+  if (!(sig.length > 0) || !(sig.bounding_radius > 0)) return Status::invalid_radius;
+  if (sig.material.restitution < 0 || sig.material.restitution > 1 || sig.material.friction < 0)
+    return Status::invalid_material;
+  const Status layout = check_signature_layout(sig);
+  if (layout != Status::ok) return layout;
+  return check_signature_values(sig);
+}
+
+}  // namespace detail
+}  // namespace statsim

@@ -1,0 +1,222 @@
+#pragma once
+/// @file
+/// The data the phases of a step share: `WorldData` (the world's arrays, counts and parameters,
+/// capacity-erased), `StepContext` (what one step counts as it goes), the first phase
+/// (`integrate`) and the state hash.
+
+#include "statsim/world_def.hpp"
+#include "statsim/random.hpp"
+
+#include <cstdint>
+
+namespace statsim {
+namespace detail {
+
+/// A world's storage (owned by `World<>`), counts and parameters: what every phase reads.
+template <int D>
+struct WorldData {
+  Body<D>* bodies;
+  SweepEntry* entries;  ///< the sweep-and-prune order of the first `entry_count` bodies
+  Pair* pairs;
+  Plane<D>* planes;
+  Shape<D>* shapes;
+  SpatialHash<D> grid;
+  std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
+  std::uint32_t body_count = 0, pair_count = 0, plane_count = 0, shape_count = 0;
+  /// Bodies that have a sweep entry: sweep-and-prune adds the entries of newer bodies when it
+  /// next runs, so the grid never touches them.
+  std::uint32_t entry_count = 0;
+  std::uint64_t step_count = 0;
+  std::uint64_t energy_clamps = 0;  ///< over the world's life
+  WorldDef<D> def{};
+};
+
+/// What one step counts as its phases run; the passes reset the counter they test.
+struct StepContext {
+  /// Body-body contacts of the impact pass: the pairs at the front of the pair buffer that the
+  /// later passes visit.
+  std::uint32_t touching = 0;
+  std::uint32_t moves = 0;          ///< position corrections since the counter was reset
+  std::uint32_t changes = 0;        ///< impulses and position corrections since it was reset
+  std::uint32_t energy_clamps = 0;  ///< sampled responses the energy guard scaled down
+};
+
+/// Lever arm of a body in the particle response: its radius for a sphere; 0 for a statistical
+/// body, whose sphere is not its shape, so friction on the sphere must not spin it (a spin it
+/// does not have would come back as speed).
+template <int D>
+Scalar contact_radius(const WorldData<D>& w, const Body<D>& b)
+{
+  return w.shapes[b.shape].statistical ? Scalar(0) : b.radius;
+}
+
+/// The body's random stream, where it left off.
+template <int D>
+Pcg32 rng_of(const WorldData<D>& w, const Body<D>& b)
+{
+  return Pcg32::resume(b.rng_state, body_stream(w.def.seed, std::uint32_t(&b - w.bodies)));
+}
+
+template <int D>
+void wake(Body<D>& b)
+{
+  b.state = MotionState::moving;
+  b.slow_time = 0;
+  b.step_start = b.position;  // a sleeper is not integrated: this is where it started the step
+}
+
+/// Semi-implicit Euler for awake bodies: gravity and damping change the velocity, which then
+/// moves the body; orientation without trigonometry (`detail::integrate`).
+template <int D>
+void integrate(WorldData<D>& w, Scalar dt)
+{
+  using Vec = typename Space<D>::Vec;
+  const Vec dv = w.def.gravity * dt;
+  const Scalar lin_damp = Scalar(1) / (1 + dt * w.def.linear_damping);
+  const Scalar ang_damp = Scalar(1) / (1 + dt * w.def.angular_damping);
+  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+    Body<D>& b = w.bodies[i];
+    if (b.state == MotionState::asleep) continue;
+    b.step_start = b.position;
+    b.linear_velocity = (b.linear_velocity + dv) * lin_damp;
+    b.angular_velocity = b.angular_velocity * ang_damp;
+    b.position += b.linear_velocity * dt;
+    b.orientation = integrate(b.orientation, b.angular_velocity, dt);
+  }
+}
+
+/// Adds every parameter of a world to a hash. A new `WorldDef` field belongs here too.
+template <int D>
+void hash_def(Fnv1a& h, const WorldDef<D>& d)
+{
+  h.add_vec(d.gravity);
+  h.add(d.seed);
+  h.add(d.restitution_threshold);
+  h.add(d.settle_speed);
+  h.add(d.sleep_speed);
+  h.add(d.sleep_time);
+  h.add(d.wake_speed);
+  h.add(d.linear_damping);
+  h.add(d.angular_damping);
+  h.add(std::int32_t(d.support_iterations));
+  h.add(std::uint8_t(d.shock_propagation));
+  h.add(std::int32_t(d.position_iterations));
+  h.add(d.allowed_overlap);
+  h.add(d.overlap_correction);
+  h.add(d.spin_ratio_speed_floor);
+  h.add(std::uint8_t(d.nearest_radius));
+  h.add(std::uint8_t(d.pair_response));
+  h.add(std::uint8_t(d.rest_conditions));
+  h.add(std::uint8_t(d.pile_rest));
+  h.add(d.rest_blend_time);
+  h.add(d.rest_turn_time);
+  h.add(d.rest_snap_cosine);
+  h.add(d.ground_cosine);
+  h.add(std::uint8_t(d.broad_phase));
+  h.add(d.grid_above_bodies);
+  h.add(std::int32_t(d.sweep_axis));
+}
+
+/// Adds a table's numbers as the runtime reads them (16-bit ones as their values).
+inline void hash_values(Fnv1a& h, const ValuesView& v, std::uint32_t n)
+{
+  for (std::uint32_t i = 0; i < n; ++i) h.add(v[i]);
+}
+inline void hash_axis(Fnv1a& h, const AxisView& a)
+{
+  h.add(a.size);
+  for (std::uint32_t i = 0; i < a.size; ++i) h.add(a.values[i]);
+}
+
+/// FNV-1a hash of everything of a signature that a step reads: its scalars, axes, tables and
+/// rest poses. Computed once, by `add_shape`; the signature must have passed `check_signature`.
+template <int D>
+std::uint64_t signature_hash(const SignatureView<D>& sig)
+{
+  Fnv1a h;
+  h.add(sig.length);
+  h.add(sig.bounding_radius);
+  h.add(sig.mass);
+  for (const Scalar x : sig.unit_inertia) h.add(x);
+  h.add(sig.material.restitution);
+  h.add(sig.material.friction);
+  h.add(sig.material.rolling_resistance);
+  h.add(sig.restitution_threshold);
+  h.add(std::uint8_t(sig.layout));
+  hash_axis(h, sig.height.spin_ratio);
+  hash_values(h, sig.height.mean, sig.height.spin_ratio.size);
+  hash_values(h, sig.height.stddev, sig.height.spin_ratio.size);
+  const ResponseTableView& r = sig.response;
+  h.add(r.axis_count);
+  h.add(r.components);
+  std::uint32_t values = r.components;
+  for (std::uint32_t a = 0; a < r.axis_count; ++a) {
+    hash_axis(h, r.axes[a]);
+    values *= r.axes[a].size;
+  }
+  hash_values(h, r.mean, values);
+  hash_values(h, r.stddev, values);
+  h.add(sig.rest.count);
+  for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+    h.add_vec(sig.rest.normal(i));
+    h.add(sig.rest.heights[i]);
+    h.add(sig.rest.frequencies[i]);
+  }
+  return h.value;
+}
+
+/// FNV-1a hash of the world's state (see `WorldCore::state_hash`).
+template <int D>
+std::uint64_t state_hash(const WorldData<D>& w)
+{
+  Fnv1a h;
+  h.add(w.body_count);
+  h.add(w.plane_count);
+  h.add(w.shape_count);
+  h.add(w.step_count);
+  hash_def(h, w.def);
+  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+    const Body<D>& b = w.bodies[i];
+    h.add_vec(b.position);
+    h.add_rot(b.orientation);
+    h.add_vec(b.linear_velocity);
+    h.add_spin(b.angular_velocity);
+    h.add(b.radius);
+    h.add(b.bounding_radius);
+    h.add(b.inv_mass);
+    h.add(b.slow_time);
+    h.add(b.rng_state);
+    h.add(b.rest_blend);
+    h.add(b.shape);
+    h.add(std::uint8_t(b.state));
+    h.add(std::uint8_t(b.touching));
+    h.add(std::uint8_t(b.on_ground));
+    h.add(b.rest_pose);
+    h.add(std::uint8_t(b.pile_rest));
+  }
+  for (std::uint32_t i = 0; i < w.plane_count; ++i) {
+    h.add_vec(w.planes[i].normal);
+    h.add(w.planes[i].offset);
+  }
+  for (std::uint32_t i = 0; i < w.shape_count; ++i) {
+    const Shape<D>& s = w.shapes[i];
+    h.add(s.radius);
+    h.add(s.bounding_radius);
+    h.add(s.material.restitution);
+    h.add(s.material.friction);
+    h.add(s.material.rolling_resistance);
+    h.add(std::uint8_t(s.statistical));
+    if (!s.statistical) continue;
+    h.add(s.signature_hash);
+    h.add(s.mean_rest_height);
+    for (std::uint32_t k = 0; k < s.signature.rest.count; ++k) h.add(s.rest_bias[k]);
+  }
+  // The sweep-and-prune order breaks ties between equal interval starts, so it decides the order
+  // of pairs, and with it of contacts.
+  h.add(w.entry_count);
+  for (std::uint32_t i = 0; i < w.entry_count; ++i) h.add(w.entries[i].body);
+  return h.value;
+}
+
+}  // namespace detail
+}  // namespace statsim

@@ -1,0 +1,228 @@
+#pragma once
+/// @file
+/// What a world is made of: the limits on inputs, the ids, the definitions users fill in
+/// (`ShapeDef`, `BodyDef`, `WorldDef`) and the state the world keeps (`Body`, `Shape`).
+
+#include "statsim/broadphase.hpp"
+#include "statsim/contact.hpp"
+#include "statsim/statistical.hpp"
+#include "statsim/status.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+namespace statsim {
+
+/// Limits on finite inputs. Beyond them single-precision arithmetic can overflow (a speed of
+/// 1e30 m/s squared is infinite) or lose all meaning, so calls with such values are rejected with
+/// `Status::out_of_range` (or `invalid_parameter` for `WorldDef`) and change nothing.
+namespace limits {
+constexpr Scalar coordinate = Scalar(1e6);   ///< |position component|, |plane offset|, m
+constexpr Scalar speed = Scalar(1e5);        ///< |linear velocity component|, m/s
+constexpr Scalar spin = Scalar(1e7);         ///< |angular velocity component|, rad/s
+constexpr Scalar time_step = 1;              ///< largest dt of `step`, s
+constexpr Scalar min_mass = Scalar(1e-9);    ///< kg
+constexpr Scalar max_mass = Scalar(1e9);     ///< kg
+constexpr Scalar min_radius = Scalar(1e-6);  ///< collision and bounding radius, m
+constexpr Scalar max_radius = Scalar(1e4);   ///< m
+constexpr Scalar gravity = Scalar(1e4);      ///< |gravity component|, m/s^2
+}  // namespace limits
+
+namespace detail {
+template <class V>
+bool within(const V& v, Scalar bound)
+{
+  return (v.array().abs() <= bound).all();
+}
+inline bool within(Scalar x, Scalar bound) { return std::fabs(x) <= bound; }
+}  // namespace detail
+
+/// Index of a body in its world, in order of creation.
+using BodyId = std::uint32_t;
+/// Index of a shape in its world, in order of creation.
+using ShapeId = std::uint16_t;
+/// Index of a plane in its world, in order of creation.
+using PlaneId = std::uint16_t;
+
+/// What a body is doing.
+enum class MotionState : std::uint8_t {
+  moving,    ///< free flight or fast contact
+  settling,  ///< touching something and slower than `WorldDef::settle_speed`
+  asleep,    ///< not integrated; acts as a static support until hit hard enough
+};
+
+/// A shape: what all bodies made from it share. Built like Box2D's defs: start from the defaults
+/// and set what differs.
+struct ShapeDef {
+  /// Radius of the collision sphere, m. Typical: 0.05 to 1.
+  Scalar radius = Scalar(0.1);
+  /// Radius of a sphere about the centre of mass that holds the whole shape, m; the broad phase
+  /// uses it. 0 means "same as radius". Must be >= radius.
+  Scalar bounding_radius = 0;
+  /// Restitution and friction of the shape's surface.
+  Material material{};
+};
+
+/// Initial state of a body.
+template <int D>
+struct BodyDef {
+  using Vec = typename Space<D>::Vec;
+  Vec position = Vec::Zero();                                 ///< centre of mass, m
+  typename Space<D>::Rot orientation = Space<D>::identity();  ///< body to world; unit length
+  Vec linear_velocity = Vec::Zero();                          ///< m/s
+  typename Space<D>::Spin angular_velocity = Space<D>::zero_spin();  ///< rad/s, world frame
+  ShapeId shape = 0;                                          ///< from `add_shape`
+  Scalar mass = 1;                                            ///< kg, > 0
+  bool asleep = false;                                        ///< start asleep (e.g. a pre-built pile)
+};
+
+/// How a body-body impact with a statistical body is resolved (see `detail::respond_pair`).
+enum class PairResponse : std::uint8_t {
+  independent,  ///< paper 3.3.2: each body as against a fixed plane; energy can grow in piles
+  momentum,     ///< the same samples, combined into one momentum-conserving impulse
+};
+
+/// Parameters of a world. Defaults suit bodies of 5 cm to 1 m at 30 to 240 Hz.
+template <int D>
+struct WorldDef {
+  using Vec = typename Space<D>::Vec;
+  /// Gravity, m/s^2, each component within +-`limits::gravity` (1e4). Default: 9.81 down the up
+  /// axis (-z in 3D, -y in 2D).
+  Vec gravity = -Scalar(9.81) * Vec::Unit(Space<D>::up_axis);
+  /// Seed of every random stream; body i draws from stream `body_stream(seed, i)`.
+  std::uint64_t seed = 0x5eed5eedull;
+  /// Approach speed below which contacts do not bounce, m/s. Keep it above |g| dt (0.16 at
+  /// 60 Hz) so that resting bodies do not jitter.
+  Scalar restitution_threshold = Scalar(0.5);
+  /// A touching body slower than this is settling, m/s (speed = max(|v|, |w| R_bound)).
+  Scalar settle_speed = Scalar(0.5);
+  /// A touching body slower than this for `sleep_time` falls asleep, m/s. Its linear speed
+  /// counts as the lesser of |v| and the distance its centre moved in the step over dt: a body
+  /// wedged between resting ones can keep a velocity that the overlap correction undoes every
+  /// step, and it is still all the same.
+  Scalar sleep_speed = Scalar(0.05);
+  /// Seconds a touching body must stay below `sleep_speed` before it sleeps, >= 0.
+  Scalar sleep_time = Scalar(0.5);
+  /// An awake body hitting a sleeping one faster than this (normal approach, m/s) wakes it;
+  /// slower, the sleeper acts as a static support.
+  Scalar wake_speed = Scalar(0.5);
+  /// Velocity damping, 1/s: v *= 1 / (1 + dt c). 0 = none.
+  Scalar linear_damping = 0;
+  /// Spin damping, 1/s. 0 = none.
+  Scalar angular_damping = 0;
+  /// Contact passes after the impact pass, >= 1 (paper: 1). Each takes out approach velocity
+  /// left at resting contacts; a stack of k layers needs about k passes to hold still in one step.
+  int support_iterations = 4;
+  /// After the support passes, one bottom-up pass that settles stacks exactly (see `step`).
+  bool shock_propagation = true;
+  /// Passes after the shock pass that only push overlapping bodies apart, in its order and with
+  /// its frozen bodies, in [0, 64]; they need `shock_propagation`. A body wedged between several
+  /// others needs a few to come out of all of them. Typical: 0 to 4.
+  int position_iterations = 2;
+  /// Overlap of two bodies left uncorrected, as a fraction of the sum of their radii, in [0, 0.5).
+  /// Typical: 0.005 to 0.05. Resting contacts keep about this much overlap.
+  Scalar allowed_overlap = Scalar(0.01);
+  /// Fraction of the remaining overlap of two bodies removed per step, in (0, 1]. Overlaps are
+  /// corrected in the shock pass only, bottom-up with the lower body fixed, where removing them in
+  /// full lifts nothing that was not sinking; lower values leave piles more compressed.
+  Scalar overlap_correction = Scalar(1);
+  /// In the spin ratio that sets the collision radius, speeds below this count as this, m/s, so
+  /// a body resting or bouncing in place keeps a steady radius. Typical: the settle speed.
+  Scalar spin_ratio_speed_floor = Scalar(0.5);
+  /// Collision radius from the nearest height sample instead of interpolating (paper 3.3.1:
+  /// both work).
+  bool nearest_radius = false;
+  /// Body-body impacts of statistical bodies: the paper's independent responses, or the same
+  /// samples made to conserve momentum (the default: in piles the independent responses add
+  /// energy, see README).
+  PairResponse pair_response = PairResponse::momentum;
+  /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
+  bool rest_conditions = true;
+  /// Bodies settling on other bodies (not on the ground) blend their radius to the shape's
+  /// frequency-weighted mean rest height, without choosing a pose or turning. Off (the paper's
+  /// method): they rest on their h_coll spheres, which are larger than the shape's rest heights,
+  /// so piles stand taller than the reference's; on, piles stand nearer the reference's height
+  /// but take longer to fall asleep (figures: tools/ref2d/README.md, the 2D comparison).
+  bool pile_rest = false;
+  /// Seconds over which a settling body's radius blends from h_coll to h_rest (and back).
+  Scalar rest_blend_time = Scalar(0.15);
+  /// Settling bodies are turned toward their rest pose at each ground contact with an angular
+  /// velocity of (sine of the remaining angle) / rest_turn_time, rad/s, capped so that the
+  /// farthest point moves at most at `settle_speed`. Seconds, >= 1e-4.
+  Scalar rest_turn_time = Scalar(0.1);
+  /// A body turning into its rest pose may fall asleep (and snap into the pose) once the pose's
+  /// normal is within this cosine of up (0.996: about 5 degrees).
+  Scalar rest_snap_cosine = Scalar(0.996);
+  /// A plane counts as ground for resting conditions when its normal's up component is at least
+  /// this (0.9: within about 25 degrees of horizontal).
+  Scalar ground_cosine = Scalar(0.9);
+  /// The broad phase: sweep-and-prune for small worlds and the hashed grid for large ones
+  /// (default, `automatic`), or either one always.
+  BroadPhase broad_phase = BroadPhase::automatic;
+  /// With `BroadPhase::automatic`, worlds of more bodies than this use the grid, fewer
+  /// sweep-and-prune: near where the two cost the same (measured by `statsim bench`,
+  /// tools/bench/README.md).
+  std::uint32_t grid_above_bodies = 2048;
+  /// Axis the sweep-and-prune broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
+  /// along, not the up axis of a pile.
+  int sweep_axis = 0;
+};
+
+/// Full state of a body. Read it through `WorldCore::body()`; change it only through the world.
+template <int D>
+struct Body {
+  using Vec = typename Space<D>::Vec;
+  Vec position;                           ///< centre of mass, m
+  typename Space<D>::Rot orientation;     ///< body to world, unit
+  Vec linear_velocity;                    ///< m/s
+  typename Space<D>::Spin angular_velocity;  ///< rad/s
+  Scalar radius;                          ///< current collision radius, m
+  Scalar bounding_radius;                 ///< m
+  Scalar inv_mass;                        ///< 1/kg
+  Scalar slow_time;                       ///< s spent slow and touching
+  Vec step_start;                         ///< m, centre at the start of the last step (for the sleep test)
+  std::uint64_t rng_state;                ///< state of the body's PCG32 stream
+  Scalar rest_blend;                      ///< 0: radius is h_coll; 1: radius is h_rest of rest_pose
+  ShapeId shape;
+  MotionState state;
+  bool touching;                          ///< touched a plane or body in the last step
+  bool on_ground;                         ///< touched a near-horizontal plane in the last step
+  std::uint8_t rest_pose;                 ///< chosen rest pose, or `no_rest_pose`
+  bool pile_rest;                         ///< settling on other bodies, blending to the mean h_rest (`WorldDef::pile_rest`)
+};
+
+/// `Body::rest_pose` when no rest pose is chosen.
+constexpr std::uint8_t no_rest_pose = 0xff;
+
+/// Result of an `add_*` call: a status and, when ok, the new id.
+template <class Id>
+struct [[nodiscard]] Added {
+  Status status;
+  Id id;
+  constexpr bool ok() const { return status == Status::ok; }
+};
+
+/// Shape data a world keeps. A shape with a signature is statistical: its bodies take their
+/// collision radius, response and rest poses from it; without one, bodies are plain spheres with
+/// the particle response.
+template <int D>
+struct Shape {
+  /// Collision radius of a plain sphere, m; 0 for a statistical shape, whose bodies take theirs
+  /// from the signature.
+  Scalar radius;
+  Scalar bounding_radius;   ///< m
+  Material material;
+  bool statistical;
+  SignatureView<D> signature;  ///< meaningful when `statistical`
+  /// Biases of the rest-pose basins (`rest_basin_biases`), one per rest pose.
+  std::array<Scalar, max_rest_poses> rest_bias;
+  /// Frequency-weighted mean of the rest heights, m: the radius a body blends to while it
+  /// settles on other bodies (`WorldDef::pile_rest`).
+  Scalar mean_rest_height;
+  /// FNV-1a hash of the signature's numbers (`detail::signature_hash`), for `state_hash`; 0 for
+  /// a plain sphere.
+  std::uint64_t signature_hash;
+};
+
+}  // namespace statsim
