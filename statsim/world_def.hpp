@@ -135,7 +135,7 @@ struct WorldDef {
   bool nearest_radius = false;
   /// Body-body impacts of statistical bodies: the paper's independent responses, or the same
   /// samples made to conserve momentum (the default: in piles the independent responses add
-  /// energy, see README).
+  /// energy, see statsim/README.md, "Statistical bodies").
   PairResponse pair_response = PairResponse::momentum;
   /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
   bool rest_conditions = true;

@@ -3,7 +3,7 @@
 // world is left as it was.
 #include <doctest/doctest.h>
 
-#include "synthetic_signature.hpp"
+#include "scenes/synthetic_signatures.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"

@@ -2,7 +2,7 @@
 // differently never hash alike, even before their first step.
 #include <doctest/doctest.h>
 
-#include "synthetic_signature.hpp"
+#include "scenes/synthetic_signatures.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"

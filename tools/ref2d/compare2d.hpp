@@ -21,7 +21,7 @@ struct Compare2dOptions {
   std::uint64_t seed = 1;         ///< drop k (0 <= k < drops) starts from the states of seed + k
   int repeat = 3;                ///< runs per simulation; each step's time is the least of them
   /// Independent drops per method, pooled. One drop of 100 bodies is a noisy sample: Box2D's
-  /// own share of tilted bodies ranges from 0.30 to 0.75 between seeds.
+  /// own share of tilted bodies varies widely between seeds (tools/ref2d/README.md).
   int drops = 10;
   bool pile_rest = false;        ///< statsim's WorldDef::pile_rest
 };

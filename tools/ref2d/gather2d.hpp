@@ -33,9 +33,9 @@ std::vector<double> default_cos_thetas();      ///< 7 values 0.15..1
 std::vector<double> default_signed_spins();    ///< 9 values -6..6, denser near 0
 std::vector<double> default_speeds();          ///< 5 values 0.5..9 m/s
 
-/// Defaults: 16 x 1000 height drops, 315 cells x 200 response trials, 2000 rest drops: about
-/// 15 s per shape on 2 cores (Box2D steps one small body in about a microsecond), so the statistics
-/// are generous (the standard error of a response mean is 7% of its spread).
+/// Defaults: 16 x 1000 height drops, 315 cells x 200 response trials, 2000 rest drops. Box2D steps
+/// one small body so fast that generous statistics cost seconds per shape (gathering times and the
+/// standard errors they give: tools/ref2d/README.md).
 struct Gather2dOptions {
   std::string shape = "square";  ///< "square", "lshape" or "polygon"
   std::string polygon;           ///< vertices "x1,y1 x2,y2 ..." when shape == "polygon"

@@ -14,7 +14,7 @@
 //   qw..qz  orientation, unit quaternion, body to world (2D runs: a turn about z)
 //   state   0 moving, 1 settling, 2 asleep
 //   radius  collision-sphere radius, m
-// README "Pictures" documents the format for users.
+// tools/render/README.md, "Frame files", documents the format for users.
 //
 // Header-only, C stdio only: no allocation, no exceptions (the examples are built without them).
 #pragma once
