@@ -13,6 +13,7 @@
 #include "tables/square2d.hpp"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -208,6 +209,21 @@ TEST_CASE("gather2d: a tiny gather gives byte-identical headers across runs and 
     CHECK_THROWS_WITH_AS(gather2d_header(r, command), doctest::Contains("a table holds finite values only"),
                          std::invalid_argument);
   }
+}
+
+TEST_CASE("gather2d: the JSON summary parses and holds the run's statistics")
+{
+  const Gather2dResult r = run_gather2d(tiny(2));
+  const std::string command = "build/bin/statsim gather2d --shape lshape --out tables/tiny2d.hpp";
+  const nlohmann::json j = nlohmann::json::parse(gather2d_json(r, command));
+  CHECK(j.at("command") == command);
+  CHECK(j.at("name") == "tiny2d");
+  REQUIRE(j.at("heights").size() == r.heights.size());
+  CHECK(j.at("heights")[0].at("mean").get<double>() == r.heights[0].mean);
+  REQUIRE(j.at("cells").size() == r.cells.size());
+  CHECK(j.at("cells")[1].at("std")[2].get<double>() == r.cells[1].std[2]);
+  REQUIRE(j.at("rest_clusters").size() == r.clusters.size());
+  CHECK(j.at("rest_drops").get<int>() == r.rest_drops);
 }
 
 TEST_CASE("gather2d: the square rests on its 4 sides at height 0.5")

@@ -51,47 +51,43 @@ void make_parent(const std::string& file)
   if (!parent.empty()) ensure_writable_directory(parent);
 }
 
+// Errors propagate to main, which prints "statsim bench: error: ..." and exits with 1.
 void run_bench_command(BenchCommand& cmd)
 {
-  try {
-    if (!cmd.replot.empty()) {
-      // Redraw the chart of an earlier run from its CSV, without running anything.
-      if (cmd.chart.empty()) throw std::invalid_argument("--replot needs --chart FILE.png");
-      std::vector<std::string> args{cmd.replot, "--out", cmd.chart};
-      // The CSV does not hold the shape: the title names the one given, else the script's default
-      // (bunny; square for a 2D run, which it tells from the CSV).
-      if (cmd.shape_given) args.insert(args.end(), {"--shape", cmd.options.shape});
-      if (cmd.options.chart_cpu) args.push_back("--cpu");
-      make_parent(cmd.chart);
-      plot::run_script("bench.py", args);
-      std::printf("wrote %s and %s\n", cmd.chart.c_str(), plot::svg_of(cmd.chart).c_str());
-      return;
-    }
-    cmd.options.dt = parse_dt(cmd.dt);
-    cmd.options.progress = !cmd.quiet;
-    if (cmd.options.dim == 2 && cmd.options.shape == "bunny") cmd.options.shape = "square";
-    validate_bench_options(cmd.options);
-    // Fail on unwritable outputs before the run, not after it.
-    if (!cmd.csv.empty()) make_parent(cmd.csv);
-    if (!cmd.chart.empty()) {
-      make_parent(cmd.chart);
-      plot::find_python();  // a missing matplotlib too
-    }
-    const BenchResult result = run_bench(cmd.options);
-    std::fputs(bench_markdown(result).c_str(), stdout);
-    if (!cmd.csv.empty()) {
-      write_file_atomic(cmd.csv, bench_csv(result));
-      std::printf("\nwrote %s\n", cmd.csv.c_str());
-    }
-    if (!cmd.chart.empty()) {
-      write_bench_chart(result, cmd.chart);
-      std::printf("wrote %s and %s\n", cmd.chart.c_str(), plot::svg_of(cmd.chart).c_str());
-    }
-    std::fflush(stdout);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "statsim bench: error: %s\n", e.what());
-    throw CLI::RuntimeError(1);
+  if (!cmd.replot.empty()) {
+    // Redraw the chart of an earlier run from its CSV, without running anything.
+    if (cmd.chart.empty()) throw std::invalid_argument("--replot needs --chart FILE.png");
+    std::vector<std::string> args{cmd.replot, "--out", cmd.chart};
+    // The CSV does not hold the shape: the title names the one given, else the script's default
+    // (bunny; square for a 2D run, which it tells from the CSV).
+    if (cmd.shape_given) args.insert(args.end(), {"--shape", cmd.options.shape});
+    if (cmd.options.chart_cpu) args.push_back("--cpu");
+    make_parent(cmd.chart);
+    plot::run_script("bench.py", args);
+    std::printf("wrote %s and %s\n", cmd.chart.c_str(), plot::svg_of(cmd.chart).c_str());
+    return;
   }
+  cmd.options.dt = parse_dt(cmd.dt);
+  cmd.options.progress = !cmd.quiet;
+  if (cmd.options.dim == 2 && cmd.options.shape == "bunny") cmd.options.shape = "square";
+  validate_bench_options(cmd.options);
+  // Fail on unwritable outputs before the run, not after it.
+  if (!cmd.csv.empty()) make_parent(cmd.csv);
+  if (!cmd.chart.empty()) {
+    make_parent(cmd.chart);
+    plot::find_python();  // a missing matplotlib too
+  }
+  const BenchResult result = run_bench(cmd.options);
+  std::fputs(bench_markdown(result).c_str(), stdout);
+  if (!cmd.csv.empty()) {
+    write_file_atomic(cmd.csv, bench_csv(result));
+    std::printf("\nwrote %s\n", cmd.csv.c_str());
+  }
+  if (!cmd.chart.empty()) {
+    write_bench_chart(result, cmd.chart);
+    std::printf("wrote %s and %s\n", cmd.chart.c_str(), plot::svg_of(cmd.chart).c_str());
+  }
+  std::fflush(stdout);
 }
 
 }  // namespace

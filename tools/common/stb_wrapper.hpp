@@ -6,26 +6,7 @@
 // clash with another copy elsewhere in the program. stb_easy_font is all static functions.
 #pragma once
 
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#if defined(__clang__)
-#pragma GCC diagnostic ignored "-Wunknown-warning-option"
-#endif
-#pragma GCC diagnostic ignored "-Wall"
-#pragma GCC diagnostic ignored "-Wextra"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
-#pragma GCC diagnostic ignored "-Wdouble-promotion"
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-#pragma GCC diagnostic ignored "-Wcast-qual"
-#pragma GCC diagnostic ignored "-Wuseless-cast"
-#endif
+#include "common/third_party_begin.hpp"
 
 #ifndef STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_STATIC
@@ -35,7 +16,4 @@
 #endif
 #include <stb/stb_image_write.h>
 #include <stb/stb_easy_font.h>
-
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
+#include "common/third_party_end.hpp"

@@ -1,18 +1,6 @@
 // tiny_gltf.h (Debian libtinygltf-dev) with its warnings silenced: include it through this header.
 // tinygltf_impl.cpp includes it once with TINYGLTF_IMPLEMENTATION defined.
 #pragma once
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wall"
-#pragma GCC diagnostic ignored "-Wextra"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
-#endif
+#include "common/third_party_begin.hpp"
 #include <tiny_gltf.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
+#include "common/third_party_end.hpp"

@@ -3,6 +3,8 @@
 // percentile bootstrap intervals. Plain functions of their arguments, deterministic.
 #pragma once
 
+#include "common/pick.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -42,16 +44,6 @@ struct Interval {
 Interval bootstrap(std::size_t n_a, std::size_t n_b,
                    const std::function<double(const std::vector<std::size_t>&, const std::vector<std::size_t>&)>& statistic,
                    int resamples = 200, double level = 0.90, std::uint64_t seed = 0x626f6f74ull);
-
-/// The elements of `v` at `idx` (in that order).
-template <class T>
-std::vector<T> pick(const std::vector<T>& v, const std::vector<std::size_t>& idx)
-{
-  std::vector<T> out;
-  out.reserve(idx.size());
-  for (std::size_t i : idx) out.push_back(v[i]);
-  return out;
-}
 
 /// 0, 1, ..., n - 1.
 std::vector<std::size_t> iota(std::size_t n);

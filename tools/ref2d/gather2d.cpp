@@ -11,6 +11,7 @@
 #include "statsim/response.hpp"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -712,57 +713,40 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
 
 std::string gather2d_json(const Gather2dResult& r, const std::string& command)
 {
-  const auto q = [](const std::string& x) {
-    std::string out = "\"";
-    for (char c : x) {
-      if (c == '"' || c == '\\') {
-        out += '\\';
-      }
-      out += c;
-    }
-    return out + "\"";
-  };
-  const auto num = [](double x) { return fmt("%.9g", x); };
-  std::string s = "{\n";
-  s += "  \"command\": " + q(command) + ",\n";
-  s += "  \"name\": " + q(r.options.name) + ",\n";
-  s += "  \"seed\": " + std::to_string(r.options.seed) + ",\n";
-  s += "  \"length\": " + num(r.length) + ",\n";
-  s += "  \"area\": " + num(r.shape.area) + ",\n";
-  s += "  \"seconds\": {\"heights\": " + num(r.seconds_heights) + ", \"responses\": " + num(r.seconds_responses) +
-       ", \"rest\": " + num(r.seconds_rest) + "},\n";
-  s += "  \"heights\": [";
-  for (std::size_t i = 0; i < r.heights.size(); ++i) {
-    const HeightRow& h = r.heights[i];
-    s += std::string(i ? "," : "") + "\n    {\"ratio\": " + num(h.ratio) + ", \"mean\": " + num(h.mean) +
-         ", \"std\": " + num(h.std) + ", \"min\": " + num(h.min) + ", \"max\": " + num(h.max) +
-         ", \"trials\": " + std::to_string(h.trials) + ", \"late\": " + std::to_string(h.late) +
-         ", \"missed\": " + std::to_string(h.missed) + "}";
-  }
-  s += "\n  ],\n";
-  s += "  \"response_trials\": " + std::to_string(r.response_trials) + ",\n";
-  s += "  \"response_time_limited\": " + std::to_string(r.response_time_limited) + ",\n";
-  s += "  \"cells\": [";
-  for (std::size_t i = 0; i < r.cells.size(); ++i) {
-    const ResponseCell& c = r.cells[i];
-    s += std::string(i ? "," : "") + "\n    {\"cos_theta\": " + num(c.cos_theta) + ", \"spin\": " + num(c.spin) +
-         ", \"speed\": " + num(c.speed) + ", \"mean\": [" + num(c.mean[0]) + ", " + num(c.mean[1]) + ", " +
-         num(c.mean[2]) + "], \"std\": [" + num(c.std[0]) + ", " + num(c.std[1]) + ", " + num(c.std[2]) +
-         "], \"time_limited\": " + std::to_string(c.time_limited) + ", \"mean_steps\": " + num(c.mean_steps) + "}";
-  }
-  s += "\n  ],\n";
-  s += "  \"rest_drops\": " + std::to_string(r.rest_drops) + ",\n";
-  s += "  \"rest_time_limited\": " + std::to_string(r.rest_time_limited) + ",\n";
-  s += "  \"rest_clusters\": [";
-  for (std::size_t i = 0; i < r.clusters.size(); ++i) {
-    const RestCluster& c = r.clusters[i];
-    s += std::string(i ? "," : "") + "\n    {\"normal\": [" + num(c.normal.x) + ", " + num(c.normal.y) +
-         "], \"height\": " + num(c.height) + ", \"frequency\": " + num(c.frequency) +
-         ", \"count\": " + std::to_string(c.count) + ", \"spread_degrees\": " + num(c.spread_degrees) +
-         ", \"snap_degrees\": " + num(c.snap_degrees) + ", \"kept\": " + (c.kept ? "true" : "false") + "}";
-  }
-  s += "\n  ]\n}\n";
-  return s;
+  nlohmann::ordered_json j;
+  j["command"] = command;
+  j["name"] = r.options.name;
+  j["seed"] = r.options.seed;
+  j["length"] = r.length;
+  j["area"] = r.shape.area;
+  j["seconds"] = {{"heights", r.seconds_heights}, {"responses", r.seconds_responses}, {"rest", r.seconds_rest}};
+  j["heights"] = nlohmann::ordered_json::array();
+  for (const HeightRow& h : r.heights)
+    j["heights"].push_back({{"ratio", h.ratio}, {"mean", h.mean}, {"std", h.std}, {"min", h.min}, {"max", h.max},
+                            {"trials", h.trials}, {"late", h.late}, {"missed", h.missed}});
+  j["response_trials"] = r.response_trials;
+  j["response_time_limited"] = r.response_time_limited;
+  j["cells"] = nlohmann::ordered_json::array();
+  for (const ResponseCell& c : r.cells)
+    j["cells"].push_back({{"cos_theta", c.cos_theta},
+                          {"spin", c.spin},
+                          {"speed", c.speed},
+                          {"mean", {c.mean[0], c.mean[1], c.mean[2]}},
+                          {"std", {c.std[0], c.std[1], c.std[2]}},
+                          {"time_limited", c.time_limited},
+                          {"mean_steps", c.mean_steps}});
+  j["rest_drops"] = r.rest_drops;
+  j["rest_time_limited"] = r.rest_time_limited;
+  j["rest_clusters"] = nlohmann::ordered_json::array();
+  for (const RestCluster& c : r.clusters)
+    j["rest_clusters"].push_back({{"normal", {c.normal.x, c.normal.y}},
+                                  {"height", c.height},
+                                  {"frequency", c.frequency},
+                                  {"count", c.count},
+                                  {"spread_degrees", c.spread_degrees},
+                                  {"snap_degrees", c.snap_degrees},
+                                  {"kept", c.kept}});
+  return j.dump(2) + "\n";
 }
 
 std::string gather2d_summary(const Gather2dResult& r)

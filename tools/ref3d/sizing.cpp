@@ -2,6 +2,7 @@
 
 #include "common/format.hpp"
 #include "common/parallel.hpp"
+#include "common/pick.hpp"
 #include "statsim/signature.hpp"
 
 #include <algorithm>
@@ -23,14 +24,6 @@ std::vector<float> as_float(const std::vector<double>& v)
   return f;
 }
 
-template <class T>
-std::vector<T> pick(const std::vector<T>& v, const std::vector<std::size_t>& keep)
-{
-  std::vector<T> out;
-  out.reserve(keep.size());
-  for (std::size_t i : keep) out.push_back(v[i]);
-  return out;
-}
 
 std::size_t product(const std::vector<std::size_t>& sizes)
 {
