@@ -178,6 +178,12 @@ struct Fnv1a {
   {
     add_bytes(&x, sizeof x);
   }
+  /// add() of each argument, left to right.
+  template <class... T>
+  void add_all(T... x)
+  {
+    (add(x), ...);
+  }
   template <int R>
   void add_vec(const Eigen::Matrix<Scalar, R, 1>& v)
   {

@@ -90,31 +90,13 @@ template <int D>
 void hash_def(Fnv1a& h, const WorldDef<D>& d)
 {
   h.add_vec(d.gravity);
-  h.add(d.seed);
-  h.add(d.restitution_threshold);
-  h.add(d.settle_speed);
-  h.add(d.sleep_speed);
-  h.add(d.sleep_time);
-  h.add(d.wake_speed);
-  h.add(d.linear_damping);
-  h.add(d.angular_damping);
-  h.add(std::int32_t(d.support_iterations));
-  h.add(std::uint8_t(d.shock_propagation));
-  h.add(std::int32_t(d.position_iterations));
-  h.add(d.allowed_overlap);
-  h.add(d.overlap_correction);
-  h.add(d.spin_ratio_speed_floor);
-  h.add(std::uint8_t(d.nearest_radius));
-  h.add(std::uint8_t(d.pair_response));
-  h.add(std::uint8_t(d.rest_conditions));
-  h.add(std::uint8_t(d.pile_rest));
-  h.add(d.rest_blend_time);
-  h.add(d.rest_turn_time);
-  h.add(d.rest_snap_cosine);
-  h.add(d.ground_cosine);
-  h.add(std::uint8_t(d.broad_phase));
-  h.add(d.grid_above_bodies);
-  h.add(std::int32_t(d.sweep_axis));
+  h.add_all(d.seed, d.restitution_threshold, d.settle_speed, d.sleep_speed, d.sleep_time, d.wake_speed,
+            d.linear_damping, d.angular_damping, std::int32_t(d.support_iterations),
+            std::uint8_t(d.shock_propagation), std::int32_t(d.position_iterations), d.allowed_overlap,
+            d.overlap_correction, d.spin_ratio_speed_floor, std::uint8_t(d.nearest_radius),
+            std::uint8_t(d.pair_response), std::uint8_t(d.rest_conditions), std::uint8_t(d.pile_rest),
+            d.rest_blend_time, d.rest_turn_time, d.rest_snap_cosine, d.ground_cosine, std::uint8_t(d.broad_phase),
+            d.grid_above_bodies, std::int32_t(d.sweep_axis));
 }
 
 /// Adds a table's numbers as the runtime reads them (16-bit ones as their values).
@@ -134,15 +116,9 @@ template <int D>
 std::uint64_t signature_hash(const SignatureView<D>& sig)
 {
   Fnv1a h;
-  h.add(sig.length);
-  h.add(sig.bounding_radius);
-  h.add(sig.mass);
-  for (const Scalar x : sig.unit_inertia) h.add(x);
-  h.add(sig.material.restitution);
-  h.add(sig.material.friction);
-  h.add(sig.material.rolling_resistance);
-  h.add(sig.restitution_threshold);
-  h.add(std::uint8_t(sig.layout));
+  h.add_all(sig.length, sig.bounding_radius, sig.mass, sig.unit_inertia[0], sig.unit_inertia[1],
+            sig.unit_inertia[2], sig.material.restitution, sig.material.friction, sig.material.rolling_resistance,
+            sig.restitution_threshold, std::uint8_t(sig.layout));
   hash_axis(h, sig.height.spin_ratio);
   hash_values(h, sig.height.mean, sig.height.spin_ratio.size);
   hash_values(h, sig.height.stddev, sig.height.spin_ratio.size);
@@ -170,10 +146,7 @@ template <int D>
 std::uint64_t state_hash(const WorldData<D>& w)
 {
   Fnv1a h;
-  h.add(w.body_count);
-  h.add(w.plane_count);
-  h.add(w.shape_count);
-  h.add(w.step_count);
+  h.add_all(w.body_count, w.plane_count, w.shape_count, w.step_count);
   hash_def(h, w.def);
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     const Body<D>& b = w.bodies[i];
@@ -181,18 +154,9 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add_rot(b.orientation);
     h.add_vec(b.linear_velocity);
     h.add_spin(b.angular_velocity);
-    h.add(b.radius);
-    h.add(b.bounding_radius);
-    h.add(b.inv_mass);
-    h.add(b.slow_time);
-    h.add(b.rng_state);
-    h.add(b.rest_blend);
-    h.add(b.shape);
-    h.add(std::uint8_t(b.state));
-    h.add(std::uint8_t(b.touching));
-    h.add(std::uint8_t(b.on_ground));
-    h.add(b.rest_pose);
-    h.add(std::uint8_t(b.pile_rest));
+    h.add_all(b.radius, b.bounding_radius, b.inv_mass, b.slow_time, b.rng_state, b.rest_blend, b.shape,
+              std::uint8_t(b.state), std::uint8_t(b.touching), std::uint8_t(b.on_ground), b.rest_pose,
+              std::uint8_t(b.pile_rest));
   }
   for (std::uint32_t i = 0; i < w.plane_count; ++i) {
     h.add_vec(w.planes[i].normal);
@@ -200,12 +164,8 @@ std::uint64_t state_hash(const WorldData<D>& w)
   }
   for (std::uint32_t i = 0; i < w.shape_count; ++i) {
     const Shape<D>& s = w.shapes[i];
-    h.add(s.radius);
-    h.add(s.bounding_radius);
-    h.add(s.material.restitution);
-    h.add(s.material.friction);
-    h.add(s.material.rolling_resistance);
-    h.add(std::uint8_t(s.statistical));
+    h.add_all(s.radius, s.bounding_radius, s.material.restitution, s.material.friction,
+              s.material.rolling_resistance, std::uint8_t(s.statistical));
     if (!s.statistical) continue;
     h.add(s.signature_hash);
     h.add(s.mean_rest_height);

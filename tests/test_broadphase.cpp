@@ -27,6 +27,15 @@ struct Sphere {
   float r;
 };
 
+/// A sphere of radius 0.05 to 0.4 centred in |x|, |y| <= 3 and |z| <= 1 (z = 0 when `flat`).
+Sphere random_sphere(Pcg32& rng, bool flat)
+{
+  Sphere s;
+  s.c = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), flat ? 0.0f : rng.uniform(-1, 1));
+  s.r = rng.uniform(0.05f, 0.4f);
+  return s;
+}
+
 PairList brute_force(const std::vector<Sphere>& s)
 {
   PairList out;
@@ -67,8 +76,7 @@ TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many
     std::vector<Sphere> s(n);
     std::vector<Vector3> vel(n);
     for (int i = 0; i < n; ++i) {
-      s[i].c = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-1, 1));
-      s[i].r = rng.uniform(0.05f, 0.4f);
+      s[i] = random_sphere(rng, false);
       vel[i] = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 0.05f;
     }
     std::vector<SweepEntry> entries(n);
@@ -101,8 +109,7 @@ TEST_CASE("sweep over active entries finds exactly the pairs with an active memb
     std::vector<bool> active(n);
     float widest = 0;
     for (int i = 0; i < n; ++i) {
-      s[i].c = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), 0);
-      s[i].r = rng.uniform(0.05f, 0.4f);
+      s[i] = random_sphere(rng, true);
       widest = std::max(widest, 2 * s[i].r);
       active[i] = rng.uniform() < 0.2f * float(scene);
       entries[i] = SweepEntry{s[i].c.x() - s[i].r, s[i].c.x() + s[i].r, std::uint32_t(i), active[i] ? 1u : 0u};

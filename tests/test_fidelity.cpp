@@ -1,5 +1,6 @@
 // tools/fidelity: the distances of `statsim fidelity`, the JSON signature loader and a tiny
 // end-to-end run of the command.
+#include "common/commands.hpp"
 #include "fidelity/fidelity.hpp"
 #include "fidelity/metrics.hpp"
 #include "ref3d/ref3d.hpp"

@@ -2,6 +2,7 @@
 // poses, the committed tables, and the comparison with Box2D. Small configurations only.
 #include <doctest/doctest.h>
 
+#include "common/commands.hpp"
 #include "ref2d/compare2d.hpp"
 #include "ref2d/gather2d.hpp"
 #include "ref2d/polygon2d.hpp"

@@ -34,10 +34,6 @@
 #include <string>
 #include <vector>
 
-namespace CLI {
-class App;
-}
-
 namespace statsim::tools {
 
 struct BenchOptions {
@@ -113,8 +109,5 @@ std::string bench_csv(const BenchResult& result);
 /// and PATH with .svg, drawn by tools/plot/bench.py from bench_csv(). Throws std::runtime_error
 /// when the chart cannot be drawn (see plot::run_script).
 void write_bench_chart(const BenchResult& result, const std::filesystem::path& path);
-
-/// Adds `statsim bench`.
-void register_bench_commands(CLI::App& app);
 
 }  // namespace statsim::tools

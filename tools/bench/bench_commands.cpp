@@ -1,5 +1,6 @@
 // `statsim bench`: command-line front end of tools/bench.
 #include "bench/bench.hpp"
+#include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
 #include "common/plot.hpp"

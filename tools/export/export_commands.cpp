@@ -1,4 +1,5 @@
 #include "export/gltf_export.hpp"
+#include "common/commands.hpp"
 
 #include "render/frames.hpp"
 #include "render/render.hpp"

@@ -26,11 +26,3 @@ bool export_glb(const render::Frames& frames, const std::vector<const render::Re
 
 }  // namespace statsim::tools::exporter
 
-namespace CLI {
-class App;
-}
-
-namespace statsim::tools {
-/// Adds `statsim export` (a frame file as binary glTF 2.0).
-void register_export_commands(CLI::App& app);
-}  // namespace statsim::tools

@@ -15,10 +15,6 @@
 #include <utility>
 #include <vector>
 
-namespace CLI {
-class App;
-}
-
 namespace statsim::tools::fidelity {
 
 struct FidelityOptions {
@@ -152,8 +148,5 @@ struct Charts {
 void write_charts(const std::filesystem::path& json_file, const Charts& charts);
 /// The same for a result in memory.
 void write_charts(const FidelityResult& result, const Charts& charts);
-
-/// Adds `statsim fidelity`.
-void register_fidelity_commands(CLI::App& app);
 
 }  // namespace statsim::tools::fidelity

@@ -1,5 +1,6 @@
 // Output of `statsim fidelity`: the table on stdout, the JSON, the charts, and the command.
 #include "fidelity/fidelity.hpp"
+#include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
 #include "common/plot.hpp"

@@ -1,4 +1,5 @@
 #include "mesh/mesh_commands.hpp"
+#include "common/commands.hpp"
 
 #include "mesh/decimate.hpp"
 #include "mesh/mass.hpp"

@@ -8,14 +8,7 @@
 #include <iosfwd>
 #include <string>
 
-namespace CLI {
-class App;
-}
-
 namespace statsim::tools {
-
-/// Adds `mesh` with `info`, `decimate`, `spheres`, `box`, `wedge` and `lshape` to the statsim command.
-void register_mesh_commands(CLI::App& app);
 
 /// `mesh info FILE.obj [--density RHO]`: counts, volume, mass, centre of mass, inertia, principal
 /// moments and axes, bounding radius.

@@ -3,6 +3,7 @@
 // Internal to statsim_ref2d (includes Box2D).
 #pragma once
 
+#include "ref2d/first_contact.hpp"
 #include "ref2d/polygon2d.hpp"
 
 #include <box2d/box2d.h>
@@ -76,23 +77,11 @@ double core_gap(const FreeState& s, const std::vector<Point2>& verts, double t, 
 std::optional<double> first_contact_time(const FreeState& s, const std::vector<Point2>& verts, double t_max,
                                          double offset = 0.0);
 
-/// What one drop measured (see fig3.cpp's header comment for the method).
-struct FirstContact {
-  double height = 0.0;             ///< centre height at the first contact of the core shape, m
-  double report_gap = 0.0;         ///< core gap at the start of the step Box2D reported touching in, m
-  double naive_height = 0.0;       ///< centre height Box2D shows after that step, m
-  double float_drift = 0.0;        ///< |refined - exact free flight from the initial state|, m
-  double free_flight_error = 0.0;  ///< largest deviation of a contact-free Box2D step from the analytic motion
-  int steps = 0;                   ///< Box2D steps taken
-  bool late = false;               ///< Box2D noticed the contact one step late
-  bool missed = false;             ///< Box2D missed the first contact (a corner dipped through and out)
-  bool grazing = false;            ///< the refinement and the exact free flight disagree by > 10 um of travel
-};
-
 /// Drops a body of the given pieces with its centre at (0, height), turned by `angle`, moving
 /// straight down at `speed` and spinning at `spin` (rad/s), without gravity, onto the edge y = 0,
 /// steps Box2D at `dt` until it reports touching, and returns the exact centre height at the first
-/// contact of the core shape. Throws std::runtime_error if Box2D does not move the body as
+/// contact of the core shape (`FirstContact`, first_contact.hpp; the method: fig3.cpp's header
+/// comment). Throws std::runtime_error if Box2D does not move the body as
 /// expected.
 FirstContact measure_first_contact(const std::vector<b2PolygonShape>& pieces, double height, double angle,
                                    double speed, double spin, double dt);

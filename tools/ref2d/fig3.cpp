@@ -156,23 +156,11 @@ Fig3Trial simulate_fig3_drop(const Fig3Drop& drop, double speed, double dt)
 {
   b2PolygonShape square;
   square.SetAsBox(0.5f, 0.5f);
-  FirstContact c;
   try {
-    c = measure_first_contact({square}, drop.height, drop.angle, speed, drop.spin, dt);
+    return measure_first_contact({square}, drop.height, drop.angle, speed, drop.spin, dt);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(std::string("fig3: ") + e.what());
   }
-  Fig3Trial trial;
-  trial.height = c.height;
-  trial.report_gap = c.report_gap;
-  trial.naive_height = c.naive_height;
-  trial.float_drift = c.float_drift;
-  trial.free_flight_error = c.free_flight_error;
-  trial.steps = c.steps;
-  trial.late = c.late;
-  trial.missed = c.missed;
-  trial.grazing = c.grazing;
-  return trial;
 }
 
 Fig3Result run_fig3(const Fig3Options& options)

@@ -3,6 +3,8 @@
 // function of the ratio |w|/|v| of its angular to its linear speed, measured with Box2D.
 #pragma once
 
+#include "ref2d/first_contact.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -39,32 +41,8 @@ struct Fig3Drop {
   double spin = 0.0;    ///< Angular velocity w, rad/s (either sign).
 };
 
-/// What one drop measured.
-struct Fig3Trial {
-  double height = 0.0;        ///< Centre height at the first contact of the core square (the
-                              ///< result), m.
-  double report_gap = 0.0;    ///< Core gap (lowest core vertex above the line) in Box2D's state
-                              ///< at the start of the step after which it first reported
-                              ///< touching: the state its narrow phase judged, m.
-  double naive_height = 0.0;  ///< Centre height Box2D shows after that step: what one would
-                              ///< record without the refinement, m.
-  double float_drift = 0.0;   ///< |height from the refinement - height of the exact free flight
-                              ///< from the initial state|: Box2D's float32 state rounding, m
-                              ///< (0 when `missed` or `grazing`).
-  double free_flight_error = 0.0;  ///< Largest deviation of a Box2D step without contact from
-                                   ///< the analytic motion (position m, angle rad, velocities).
-  int steps = 0;              ///< Box2D steps taken.
-  bool late = false;          ///< The core touched during the step before the one Box2D reported
-                              ///< (Box2D noticed one step late; the search window covers it).
-  bool missed = false;        ///< The core touched even earlier, before the search window, and
-                              ///< Box2D did not notice (a fast corner dipped through the line and
-                              ///< out again between steps): the analytic cross-check from the
-                              ///< initial state caught it, and its height is used.
-  bool grazing = false;       ///< The refinement from Box2D's state and the exact free flight from
-                              ///< the initial state disagree by more than 10 micrometres of travel:
-                              ///< a corner grazes the line by less than Box2D's float32 noise in
-                              ///< one of them only. The earlier contact is used.
-};
+/// What one drop measured: the first contact of the square with the line.
+using Fig3Trial = FirstContact;
 /// Summary of one ratio: statistics of the heights (std is the sample standard deviation).
 struct Fig3Row {
   double ratio = 0.0;

@@ -1,5 +1,6 @@
 // `statsim gather2d`: see gather2d.hpp.
 #include "ref2d/gather2d.hpp"
+#include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
 #include "common/parallel.hpp"

@@ -21,10 +21,6 @@
 #include <string>
 #include <vector>
 
-namespace CLI {
-class App;
-}
-
 namespace statsim::tools {
 
 /// Default axes (the runtime clamps outside them).
@@ -133,8 +129,5 @@ std::string gather2d_summary(const Gather2dResult& result);
 
 /// Quotes `s` for a POSIX shell when needed.
 std::string shell_quote(const std::string& s);
-
-/// Adds `gather2d` and `compare2d` to `app`.
-void register_gather2d_commands(CLI::App& app);
 
 }  // namespace statsim::tools

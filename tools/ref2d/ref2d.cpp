@@ -1,4 +1,4 @@
-#include "ref2d/ref2d.hpp"
+#include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
 #include "common/plot.hpp"

@@ -1,4 +1,5 @@
 #include "ref3d/ref3d.hpp"
+#include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
 #include "ref3d/gather.hpp"

@@ -130,11 +130,3 @@ Eigen::Vector3f body_colour(int index);
 
 }  // namespace statsim::tools::render
 
-namespace CLI {
-class App;
-}
-
-namespace statsim::tools {
-/// Adds `statsim render` (PNG frames, GIF, side by side) and `statsim reference-run`.
-void register_render_commands(CLI::App& app);
-}  // namespace statsim::tools

@@ -1,4 +1,5 @@
 #include "render/render.hpp"
+#include "common/commands.hpp"
 
 #include "common/progress.hpp"
 #include "render/frames.hpp"

@@ -5,14 +5,7 @@
 #include <exception>
 #include <string>
 
-#include "bench/bench.hpp"
-#include "export/gltf_export.hpp"
-#include "fidelity/fidelity.hpp"
-#include "mesh/mesh_commands.hpp"
-#include "ref2d/ref2d.hpp"
-#include "ref3d/ref3d.hpp"
-#include "render/render.hpp"
-#include "stress/stress.hpp"
+#include "common/commands.hpp"
 
 int main(int argc, char** argv)
 {

@@ -8,6 +8,7 @@
 // 2D: polygon = Box2D 2.4.1 unit square (velocity 8, position 3 iterations, its default CCD);
 // statistical2d = statsim World2 with tables/square2d.hpp.
 #include "stress/stress.hpp"
+#include "common/commands.hpp"
 
 #include "bench/bench_internal.hpp"
 #include "scenes/scenes.hpp"

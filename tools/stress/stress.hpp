@@ -9,10 +9,6 @@
 #include <string>
 #include <vector>
 
-namespace CLI {
-class App;
-}
-
 namespace statsim::tools {
 
 struct StressOptions {
@@ -37,8 +33,5 @@ std::vector<StressCell> run_stress(const StressOptions& options);
 std::string stress_json(const std::vector<StressCell>& cells);
 /// The cells as a Markdown table.
 std::string stress_markdown(const std::vector<StressCell>& cells);
-
-/// Adds `statsim stress`.
-void register_stress_commands(CLI::App& app);
 
 }  // namespace statsim::tools
