@@ -27,13 +27,15 @@ struct Sphere {
   float r;
 };
 
-/// A sphere of radius 0.05 to 0.4 centred in |x|, |y| <= 3 and |z| <= 1 (z = 0 when `flat`).
-Sphere random_sphere(Pcg32& rng, bool flat)
+/// `n` spheres of radius 0.05 to 0.4 centred in |x|, |y| <= 3 and |z| <= 1 (z = 0 when `flat`).
+std::vector<Sphere> random_spheres(Pcg32& rng, int n, bool flat)
 {
-  Sphere s;
-  s.c = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), flat ? 0.0f : rng.uniform(-1, 1));
-  s.r = rng.uniform(0.05f, 0.4f);
-  return s;
+  std::vector<Sphere> spheres(n);
+  for (Sphere& s : spheres) {
+    s.c = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), flat ? 0.0f : rng.uniform(-1, 1));
+    s.r = rng.uniform(0.05f, 0.4f);
+  }
+  return spheres;
 }
 
 PairList brute_force(const std::vector<Sphere>& s)
@@ -73,12 +75,9 @@ TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many
   Pcg32 rng(11, 0);
   for (int scene = 0; scene < 6; ++scene) {
     const int n = 50 + 60 * scene;
-    std::vector<Sphere> s(n);
+    std::vector<Sphere> s = random_spheres(rng, n, false);
     std::vector<Vector3> vel(n);
-    for (int i = 0; i < n; ++i) {
-      s[i] = random_sphere(rng, false);
-      vel[i] = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 0.05f;
-    }
+    for (Vector3& v : vel) v = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 0.05f;
     std::vector<SweepEntry> entries(n);
     for (int i = 0; i < n; ++i) entries[i] = SweepEntry{0, 0, std::uint32_t(i), 1};
     const int axis = scene % 3;
@@ -104,12 +103,11 @@ TEST_CASE("sweep over active entries finds exactly the pairs with an active memb
   Pcg32 rng(12, 0);
   for (int scene = 0; scene < 6; ++scene) {
     const int n = 100 + 80 * scene;
-    std::vector<Sphere> s(n);
+    const std::vector<Sphere> s = random_spheres(rng, n, true);
     std::vector<SweepEntry> entries(n);
     std::vector<bool> active(n);
     float widest = 0;
     for (int i = 0; i < n; ++i) {
-      s[i] = random_sphere(rng, true);
       widest = std::max(widest, 2 * s[i].r);
       active[i] = rng.uniform() < 0.2f * float(scene);
       entries[i] = SweepEntry{s[i].c.x() - s[i].r, s[i].c.x() + s[i].r, std::uint32_t(i), active[i] ? 1u : 0u};
