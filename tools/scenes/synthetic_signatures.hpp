@@ -2,7 +2,7 @@
 // Hand-made signatures for runtime tests that must not depend on gathered tables: a unit square
 // (2D) and a cube of side 0.2 m (3D), with the heights and rest poses geometry gives them and
 // plausible responses (spin kept with its sense but damped, small velocity offsets). The fuzzers
-// use them too, and `statsim bench --allow-synthetic` times them as stand-ins for a missing table.
+// use them too.
 #include "statsim/signature.hpp"
 
 namespace statsim::testing {
