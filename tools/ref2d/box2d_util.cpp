@@ -19,14 +19,6 @@ double wrap_angle(double a)
 
 }  // namespace
 
-std::uint64_t mix64(std::uint64_t x)
-{
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
 std::mt19937_64 trial_rng(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c)
 {
   return std::mt19937_64(mix64(mix64(mix64(mix64(seed) ^ a) ^ b) ^ c));

@@ -5,6 +5,7 @@
 
 #include "ref2d/first_contact.hpp"
 #include "ref2d/polygon2d.hpp"
+#include "statsim/random.hpp"  // mix64, the runtime's SplitMix64 finaliser
 
 #include <box2d/box2d.h>
 
@@ -17,8 +18,6 @@ namespace statsim::tools {
 
 // ---- random numbers: a per-trial std::mt19937_64 seeded by hashing a few integers -------------
 
-/// splitmix64 finaliser.
-std::uint64_t mix64(std::uint64_t x);
 /// A generator seeded from (seed, a, b, c) only: mix64(mix64(mix64(mix64(seed) ^ a) ^ b) ^ c).
 std::mt19937_64 trial_rng(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c);
 /// Uniform in [0, 1) from 53 random bits (std::uniform_real_distribution is not specified bit for
