@@ -273,8 +273,8 @@ constexpr SignatureView<D> signature_view(const S& s)
   v.height.spin_ratio = detail::axis_view(s.height_axis);
   v.height.mean = detail::values_view(s.height_mean);
   v.height.stddev = detail::values_view(s.height_stddev);
-  v.response.axes = {detail::axis_view(s.axis0), detail::axis_view(s.axis1), detail::axis_view(s.axis2),
-                     detail::axis_view(s.axis3)};
+  v.response.axes = {{detail::axis_view(s.axis0), detail::axis_view(s.axis1), detail::axis_view(s.axis2),
+                      detail::axis_view(s.axis3)}};
   v.response.axis_count = s.axis_count;
   v.response.components = D == 3 ? 6u : 3u;
   v.response.mean = detail::values_view(s.response_mean);
