@@ -419,6 +419,8 @@ GatherResult gather(const GatherOptions& options)
       } else {
         for (std::size_t t = 0; t < trials; ++t) pooled.push_back(&all[cell * trials + t]);
       }
+      std::vector<Response>& outcomes = r.cell_outcomes.emplace_back();
+      for (const ResponseTrial* t : pooled) outcomes.push_back(t->value);
       for (int c = 0; c < 6; ++c) {
         const Stats s = stats(pooled.size(), [&](std::size_t k) { return pooled[k]->value[c]; });
         r.response_mean[cell * 6 + c] = s.mean;

@@ -101,6 +101,9 @@ struct GatherResult {
   // responses
   std::vector<std::vector<double>> axes;  ///< 3 (scaled) or 4 (with speed) axes, in table order
   std::vector<double> response_mean, response_std;  ///< cells x 6, row-major in the axes
+  /// Per cell, the trial outcomes its statistics were taken over (at spin ratio 0, the trials of
+  /// every cos phi of its cos theta and speed, pooled).
+  std::vector<std::vector<Response>> cell_outcomes;
   long long response_trials = 0;
   long long time_limited = 0;
   double max_penetration = 0.0;

@@ -398,11 +398,14 @@ GatherResult sized_result(const GatherResult& dense, const SizingResult& s, cons
   const std::vector<std::size_t> cells = kept_cells(axis_sizes(dense.axes), c.keep);
   r.response_mean.clear();
   r.response_std.clear();
-  for (std::size_t cell : cells)
+  r.cell_outcomes.clear();
+  for (std::size_t cell : cells) {
+    if (cell < dense.cell_outcomes.size()) r.cell_outcomes.push_back(dense.cell_outcomes[cell]);
     for (std::size_t k = 0; k < 6; ++k) {
       r.response_mean.push_back(dense.response_mean[cell * 6 + k]);
       r.response_std.push_back(dense.response_std[cell * 6 + k]);
     }
+  }
   r.notes = notes;
   return r;
 }
