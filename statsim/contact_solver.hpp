@@ -73,6 +73,7 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
     const ResponseOutcome o = statistical_response<D>(shape.signature, b.orientation, n, v, b.angular_velocity, rng);
     b.rng_state = rng.state();
     ctx.energy_clamps += o.energy_clamped;
+    ctx.statistical_responses += o.applied;
   }
   b.linear_velocity = v + other_velocity;
 }

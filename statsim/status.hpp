@@ -64,6 +64,7 @@ struct [[nodiscard]] StepResult {
   std::uint32_t pairs_dropped = 0;   ///< candidate pairs that did not fit the pair buffer
   std::uint32_t contacts = 0;        ///< body-body and body-plane contacts resolved
   std::uint32_t energy_clamps = 0;   ///< sampled responses the energy guard scaled down
+  std::uint32_t statistical_responses = 0;  ///< sampled responses applied (body-plane and body-body)
   /// True when the step ran and nothing overflowed.
   constexpr bool ok() const { return status == Status::ok && overflow == overflow_none; }
 };

@@ -208,7 +208,9 @@ class WorldCore {
     }
     detail::update_motion_states(w_, dt);
     result.energy_clamps = ctx.energy_clamps;
+    result.statistical_responses = ctx.statistical_responses;
     w_.energy_clamps += ctx.energy_clamps;
+    w_.statistical_responses += ctx.statistical_responses;
     ++w_.step_count;
     return result;
   }
@@ -223,6 +225,9 @@ class WorldCore {
   std::uint64_t step_count() const { return w_.step_count; }
   /// Sampled responses scaled down by the energy guard, over the world's life.
   std::uint64_t energy_clamp_count() const { return w_.energy_clamps; }
+  /// Sampled (statistical) responses applied, over the world's life: the energy guard's clamp
+  /// rate is energy_clamp_count() / statistical_response_count().
+  std::uint64_t statistical_response_count() const { return w_.statistical_responses; }
 
   /// A body's state. `id` must be < body_count() (checked by STATSIM_ASSERT).
   const Body<D>& body(BodyId id) const

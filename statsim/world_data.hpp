@@ -28,6 +28,7 @@ struct WorldData {
   std::uint32_t entry_count = 0;
   std::uint64_t step_count = 0;
   std::uint64_t energy_clamps = 0;  ///< over the world's life
+  std::uint64_t statistical_responses = 0;  ///< over the world's life
   WorldDef<D> def{};
 };
 
@@ -39,6 +40,7 @@ struct StepContext {
   std::uint32_t moves = 0;          ///< position corrections since the counter was reset
   std::uint32_t changes = 0;        ///< impulses and position corrections since it was reset
   std::uint32_t energy_clamps = 0;  ///< sampled responses the energy guard scaled down
+  std::uint32_t statistical_responses = 0;  ///< sampled responses applied
 };
 
 /// Lever arm of a body in the particle response: its radius for a sphere; 0 for a statistical
