@@ -32,7 +32,7 @@
 
 /// Version of the layout of generated signature tables. A table generated for another version
 /// fails to compile against this runtime (the tables static_assert on it).
-#define STATSIM_TABLE_FORMAT_VERSION 1
+#define STATSIM_TABLE_FORMAT_VERSION 2
 
 namespace statsim {
 

@@ -18,6 +18,10 @@
 /// Responses are stored normalised: W+ L / |V-| and (V_rigid+ - V_particle+) / |V-|, in the
 /// canonical frame (paper Figure 4a): normal = last axis (z in 3D, y in 2D), V- in the plane of
 /// the first and last axes with a non-negative first component.
+///
+/// Each cell holds the mean of its C response components (3D: 6, 2D: 3) and a spread whose form
+/// the table's `ResponseModel` names (see there): C standard deviations (the paper's model), a
+/// Cholesky factor of the C x C covariance, or K stored outcomes.
 
 #include "statsim/config.hpp"
 #include "statsim/response.hpp"
@@ -92,33 +96,74 @@ struct HeightTableView {
 /// Largest number of axes of a response table (the paper's 4D layout).
 constexpr std::uint32_t max_response_axes = 4;
 
-/// Response statistics on a grid (paper 3.2.2): `components` means and standard deviations per
-/// cell, cells in row-major order of the axes (the first axis varies slowest).
+/// Most response components (3D: w_xyz, dv_xyz).
+constexpr std::uint32_t max_response_components = 6;
+
+/// Most stored outcomes per cell of an `empirical` table.
+constexpr std::uint32_t max_empirical_outcomes = 64;
+
+/// How a response table describes the spread of a cell's outcomes about its mean; chosen at
+/// gathering (`statsim gather --response-model`). C is the number of components (3D: 6, 2D: 3).
+enum class ResponseModel : std::uint8_t {
+  /// The paper's model (3.2.2): C standard deviations per cell, each component drawn from its
+  /// own Gaussian. Keeps means and spreads, drops the correlations between components and
+  /// any cell with two outcomes.
+  independent_gaussian,
+  /// C (C + 1) / 2 numbers per cell: the lower triangle, row by row, of a Cholesky factor L of
+  /// the cell's covariance (L L^T = covariance). A draw is mean + L z, z standard normal, so the
+  /// correlations between components (an impact that gains spin loses rebound) are kept.
+  correlated_gaussian,
+  /// K C numbers per cell: K outcomes of the reference's trials, each stored as its offset from
+  /// the cell's mean. A draw is the interpolated mean plus one stored offset of one corner cell
+  /// (the corner picked with its interpolation weight), so a cell with two outcomes keeps both.
+  empirical,
+};
+
+/// The number of spread values per cell of `model` with `components` components and, for
+/// `empirical`, `outcomes` stored outcomes.
+constexpr std::uint32_t response_spread_size(ResponseModel model, std::uint32_t components, std::uint32_t outcomes = 0)
+{
+  return model == ResponseModel::independent_gaussian  ? components
+         : model == ResponseModel::correlated_gaussian ? components * (components + 1) / 2
+                                                       : components * outcomes;
+}
+
+/// A cell of a response table and its weight in a multilinear interpolation.
+struct CellWeight {
+  std::uint32_t cell;
+  Scalar weight;
+};
+
+/// Response statistics on a grid (paper 3.2.2): per cell, `components` means and
+/// `spread_per_cell` spread values (their form: `model`), cells in row-major order of the axes
+/// (the first axis varies slowest).
 struct ResponseTableView {
   std::array<AxisView, max_response_axes> axes{};
   std::uint32_t axis_count = 0;
   std::uint32_t components = 0;
+  ResponseModel model = ResponseModel::independent_gaussian;
+  std::uint32_t spread_per_cell = 0;  ///< see `response_spread_size`
   ValuesView mean;
-  ValuesView stddev;
+  ValuesView spread;
 
-  /// Multilinear interpolation of mean and stddev at `x` (one coordinate per axis), clamped at
-  /// the table's edges. Writes `components` values to each output.
-  void lookup(const Scalar* x, Scalar* mean_out, Scalar* stddev_out) const
+  /// The cells around `x` (one coordinate per axis, clamped at the table's edges) with their
+  /// multilinear weights, those of weight 0 left out; returns how many (at most
+  /// 2^axis_count). An axis of one sample contributes weight 1 at index 0.
+  std::uint32_t corners(const Scalar* x, CellWeight* out) const
   {
     STATSIM_ASSERT(axis_count >= 1 && axis_count <= max_response_axes);
     AxisPoint p[max_response_axes];
     std::uint32_t stride[max_response_axes];
-    std::uint32_t s = components;
+    std::uint32_t s = 1;
     for (std::uint32_t a = axis_count; a-- > 0;) {
       p[a] = locate(axes[a], x[a]);
       stride[a] = s;
       s *= axes[a].size;
     }
-    for (std::uint32_t c = 0; c < components; ++c) mean_out[c] = stddev_out[c] = 0;
-    // Visit the 2^axis_count corners; an axis of one sample contributes weight 1 at index 0.
+    std::uint32_t n = 0;
     for (std::uint32_t corner = 0; corner < (1u << axis_count); ++corner) {
       Scalar w = 1;
-      std::uint32_t offset = 0;
+      std::uint32_t cell = 0;
       for (std::uint32_t a = 0; a < axis_count; ++a) {
         const bool upper = (corner >> a) & 1u;
         if (axes[a].size == 1) {
@@ -126,13 +171,33 @@ struct ResponseTableView {
           continue;
         }
         w *= upper ? p[a].t : 1 - p[a].t;
-        offset += (p[a].index + (upper ? 1u : 0u)) * stride[a];
+        cell += (p[a].index + (upper ? 1u : 0u)) * stride[a];
       }
       if (w == 0) continue;
-      for (std::uint32_t c = 0; c < components; ++c) {
-        mean_out[c] += w * mean[offset + c];
-        stddev_out[c] += w * stddev[offset + c];
-      }
+      out[n++] = {cell, w};
+    }
+    return n;
+  }
+
+  /// Multilinear interpolation at `x` of the means (`components` values to `mean_out`) and,
+  /// when `spread_out` is given, of the spread values (`spread_per_cell` values), clamped at
+  /// the table's edges. Interpolated standard deviations and Cholesky factors are again valid
+  /// ones (a convex combination keeps the diagonal non-negative); stored outcomes are not
+  /// interpolated this way by the runtime (see `ResponseModel::empirical`).
+  void lookup(const Scalar* x, Scalar* mean_out, Scalar* spread_out = nullptr) const
+  {
+    CellWeight cw[1u << max_response_axes];
+    const std::uint32_t n = corners(x, cw);
+    for (std::uint32_t c = 0; c < components; ++c) mean_out[c] = 0;
+    if (spread_out)
+      for (std::uint32_t c = 0; c < spread_per_cell; ++c) spread_out[c] = 0;
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const Scalar w = cw[k].weight;
+      const std::uint32_t m = cw[k].cell * components;
+      for (std::uint32_t c = 0; c < components; ++c) mean_out[c] += w * mean[m + c];
+      if (!spread_out) continue;
+      const std::uint32_t o = cw[k].cell * spread_per_cell;
+      for (std::uint32_t c = 0; c < spread_per_cell; ++c) spread_out[c] += w * spread[o + c];
     }
   }
 };
@@ -179,7 +244,7 @@ struct SignatureView {
 };
 
 /// 16-bit storage of N table values: value = offset + scale * Scalar(q[i]).
-template <std::uint32_t N>
+template <std::size_t N>
 struct Quantized16 {
   Scalar scale;
   Scalar offset;
@@ -212,6 +277,16 @@ constexpr ValuesView values_view(const Values& v)
     return ValuesView{nullptr, v.q.data(), v.scale, v.offset};
   } else {
     return ValuesView{v.data(), nullptr, 1, 0};
+  }
+}
+
+template <class Values>
+constexpr std::uint32_t values_count(const Values& v)
+{
+  if constexpr (is_quantized<Values>::value) {
+    return static_cast<std::uint32_t>(v.q.size());
+  } else {
+    return static_cast<std::uint32_t>(v.size());
   }
 }
 
@@ -277,8 +352,15 @@ constexpr SignatureView<D> signature_view(const S& s)
                       detail::axis_view(s.axis3)}};
   v.response.axis_count = s.axis_count;
   v.response.components = D == 3 ? 6u : 3u;
+  v.response.model = s.model;
+  // Spread values per cell from the stored count; a count that is not a whole number of cells
+  // gives a size no model has, which `add_shape` rejects.
+  std::uint32_t cells = 1;
+  for (std::uint32_t a = 0; a < s.axis_count && a < max_response_axes; ++a) cells *= v.response.axes[a].size;
+  const std::uint32_t spread_count = detail::values_count(s.response_spread);
+  v.response.spread_per_cell = cells > 0 && spread_count % cells == 0 ? spread_count / cells : 0;
   v.response.mean = detail::values_view(s.response_mean);
-  v.response.stddev = detail::values_view(s.response_stddev);
+  v.response.spread = detail::values_view(s.response_spread);
   v.rest.normals = s.rest_normals.data();
   v.rest.heights = s.rest_heights.data();
   v.rest.frequencies = s.rest_frequencies.data();
@@ -287,11 +369,11 @@ constexpr SignatureView<D> signature_view(const S& s)
 }
 
 /// Storage of a generated signature; sizes are template arguments. Aggregate-initialised by the
-/// generated header, read by the runtime through `view()`. `Responses` holds one response table:
-/// `std::array<Scalar, N>` (`Signature`) or `Quantized16<N>` (`SignatureQ16`).
+/// generated header, read by the runtime through `view()`. `Means` and `Spreads` hold the
+/// response tables: `std::array<Scalar, N>` (`Signature`) or `Quantized16<N>` (`SignatureQ16`).
 ///   NH: height samples; A0..A3: response axis sizes (unused axes 1); NR: rest poses.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, class Responses>
+          std::uint32_t NR, class Means, class Spreads>
 struct BasicSignature {
   static constexpr std::uint32_t components = D == 3 ? 6 : 3;
   static constexpr std::uint32_t cells = A0 * A1 * A2 * A3;
@@ -305,6 +387,7 @@ struct BasicSignature {
   Material material;
   Scalar restitution_threshold;
   ResponseLayout layout;
+  ResponseModel model;
   std::uint32_t axis_count;
   std::array<Scalar, NH> height_axis;
   std::array<Scalar, NH> height_mean;
@@ -313,8 +396,8 @@ struct BasicSignature {
   std::array<Scalar, A1> axis1;
   std::array<Scalar, A2> axis2;
   std::array<Scalar, A3> axis3;
-  Responses response_mean;
-  Responses response_stddev;
+  Means response_mean;
+  Spreads response_spread;  ///< per cell: the spread values of `model`
   std::array<Scalar, NR * D> rest_normals;
   std::array<Scalar, NR> rest_heights;
   std::array<Scalar, NR> rest_frequencies;
@@ -323,33 +406,37 @@ struct BasicSignature {
 };
 
 /// A signature with float response tables: what `statsim gather` and `gather2d` write.
+/// S: spread values per cell (`response_spread_size` of the table's model; the default is the
+/// paper's model, one standard deviation per component).
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR>
-using Signature =
-    BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>>;
+          std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u)>
+using Signature = BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>,
+                                 std::array<Scalar, A0 * A1 * A2 * A3 * S>>;
 
 /// A signature whose response tables are 16-bit integers (one scale and offset per table), for
 /// firmware where flash is tight; made from a `Signature` by `quantize16`.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR>
-using SignatureQ16 = BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>>;
+          std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u)>
+using SignatureQ16 = BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>,
+                                    Quantized16<A0 * A1 * A2 * A3 * S>>;
 
 /// The 16-bit form of a float signature, by the rule of `quantize16`: everything but the response
 /// tables is copied. `inline constexpr auto t16 = statsim::quantize16(tables::box);` keeps only
 /// the 16-bit table in the program.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR>
-constexpr SignatureQ16<D, NH, A0, A1, A2, A3, NR> quantize16(const Signature<D, NH, A0, A1, A2, A3, NR>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS>
+constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>> quantize16(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>>& s)
 {
-  SignatureQ16<D, NH, A0, A1, A2, A3, NR> q{s.name, s.length, s.bounding_radius, s.mass, s.unit_inertia,
-                                            s.material, s.restitution_threshold, s.layout, s.axis_count,
-                                            s.height_axis, s.height_mean, s.height_stddev, s.axis0, s.axis1,
-                                            s.axis2, s.axis3, {}, {}, s.rest_normals, s.rest_heights,
-                                            s.rest_frequencies};
+  BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>> q{
+      s.name,        s.length,      s.bounding_radius, s.mass,         s.unit_inertia, s.material,
+      s.restitution_threshold,      s.layout,          s.model,        s.axis_count,   s.height_axis,
+      s.height_mean, s.height_stddev, s.axis0,         s.axis1,        s.axis2,        s.axis3,
+      {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies};
   quantize16(s.response_mean.data(), s.response_mean.size(), q.response_mean.scale, q.response_mean.offset,
              q.response_mean.q.data());
-  quantize16(s.response_stddev.data(), s.response_stddev.size(), q.response_stddev.scale,
-             q.response_stddev.offset, q.response_stddev.q.data());
+  quantize16(s.response_spread.data(), s.response_spread.size(), q.response_spread.scale,
+             q.response_spread.offset, q.response_spread.q.data());
   return q;
 }
 

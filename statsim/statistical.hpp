@@ -132,6 +132,73 @@ std::uint32_t response_coordinates(const SignatureView<D>& sig, const ContactFra
   return k;
 }
 
+/// One draw of a response table's model at table coordinates `x` (one per axis): writes
+/// `table.components` normalised response components to `out`. The table must have passed
+/// `add_shape`'s checks (its spread size is its model's).
+inline void sample_response(const ResponseTableView& table, const Scalar* x, Pcg32& rng, Scalar* out)
+{
+  constexpr std::uint32_t C = max_response_components;
+  const std::uint32_t n = table.components;
+  STATSIM_ASSERT(n <= C);
+  Scalar mean[C];
+  switch (table.model) {
+    case ResponseModel::independent_gaussian: {
+      Scalar stddev[C];
+      table.lookup(x, mean, stddev);
+      for (std::uint32_t c = 0; c < n; c += 2) {
+        float g0, g1;
+        rng.gaussian_pair(g0, g1);
+        out[c] = mean[c] + stddev[c] * g0;
+        if (c + 1 < n) out[c + 1] = mean[c + 1] + stddev[c + 1] * g1;
+      }
+      return;
+    }
+    case ResponseModel::correlated_gaussian: {
+      // out = mean + L z, L lower triangular stored row by row: row i starts at i (i + 1) / 2.
+      Scalar factor[C * (C + 1) / 2], z[C];
+      table.lookup(x, mean, factor);
+      for (std::uint32_t c = 0; c < n; c += 2) {
+        float g0, g1;
+        rng.gaussian_pair(g0, g1);
+        z[c] = g0;
+        if (c + 1 < n) z[c + 1] = g1;
+      }
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const Scalar* row = factor + i * (i + 1) / 2;
+        Scalar sum = mean[i];
+        for (std::uint32_t j = 0; j <= i; ++j) sum += row[j] * z[j];
+        out[i] = sum;
+      }
+      return;
+    }
+    case ResponseModel::empirical: {
+      // A mixture of the corner cells, each with its interpolation weight (their means
+      // interpolate as in the Gaussian models): one stored outcome of one corner, about the
+      // interpolated mean. Picking rather than blending outcomes keeps a cell's separate modes.
+      CellWeight cw[1u << max_response_axes];
+      const std::uint32_t corners = table.corners(x, cw);
+      table.lookup(x, mean);
+      const Scalar u = rng.uniform();
+      std::uint32_t pick = corners - 1;
+      Scalar below = 0;
+      for (std::uint32_t k = 0; k + 1 < corners; ++k) {
+        below += cw[k].weight;
+        if (u < below) {
+          pick = k;
+          break;
+        }
+      }
+      const std::uint32_t outcomes = table.spread_per_cell / n;
+      // Multiply-shift maps 32 random bits onto [0, outcomes) without a division.
+      const std::uint32_t k = std::uint32_t((std::uint64_t(rng.next_u32()) * outcomes) >> 32);
+      const std::uint32_t base = cw[pick].cell * table.spread_per_cell + k * n;
+      for (std::uint32_t c = 0; c < n; ++c) out[c] = mean[c] + table.spread[base + c];
+      return;
+    }
+  }
+  for (std::uint32_t c = 0; c < n; ++c) out[c] = 0;  // unreachable for a checked table
+}
+
 /// The statistical response of paper 3.3.2, steps 2 to 8, for one body against a collision
 /// plane with unit normal `n` (pointing towards the body). `v` is the body's velocity relative to
 /// the plane (to the other body, for body-body contacts), `w` its spin; both are replaced.
@@ -155,15 +222,9 @@ ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename
   Scalar x[max_response_axes];
   response_coordinates<D>(sig, frame, n, v, w, x);
   constexpr int C = D == 3 ? 6 : 3;  // spin components, then velocity-offset components
-  Scalar mean[C], stddev[C], sample[C];
+  Scalar sample[C];
   STATSIM_ASSERT(sig.response.components == std::uint32_t(C));
-  sig.response.lookup(x, mean, stddev);
-  for (int c = 0; c < C; c += 2) {
-    float g0, g1;
-    rng.gaussian_pair(g0, g1);
-    sample[c] = mean[c] + stddev[c] * g0;
-    if (c + 1 < C) sample[c + 1] = mean[c + 1] + stddev[c + 1] * g1;
-  }
+  sample_response(sig.response, x, rng, sample);
 
   // Back to the world frame and to physical units: W+ = w_c |V-| / L, offset = dv_c |V-|.
   Spin w_new;
@@ -194,8 +255,7 @@ ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename
   return out;
 }
 
-/// Most rest poses a statistical shape may have. The gatherers keep poses seen in more than 5%
-/// of the reference drops, so a signature has at most 20.
+/// Most rest poses a statistical shape may have (the gatherers keep no more).
 constexpr std::uint32_t max_rest_poses = 32;
 
 /// The rest pose needing the smallest rotation (paper 3.4): the one whose body-frame normal,

@@ -80,14 +80,27 @@ Status check_signature_layout(const SignatureView<D>& sig)
   const ResponseTableView& r = sig.response;
   const std::uint32_t expected_axes = (D == 3 ? 3u : 2u) + (sig.layout == ResponseLayout::with_speed ? 1u : 0u);
   if (r.axis_count != expected_axes || r.components != (D == 3 ? 6u : 3u)) return Status::invalid_shape;
-  // Cells times components must fit the 32-bit offsets of `ResponseTableView::lookup`.
-  std::uint64_t values = r.components;
+  // The spread's size is its model's; an empirical table stores 1 to max_empirical_outcomes
+  // outcomes a cell.
+  const std::uint32_t s = r.spread_per_cell;
+  switch (r.model) {
+    case ResponseModel::independent_gaussian:
+    case ResponseModel::correlated_gaussian:
+      if (s != response_spread_size(r.model, r.components)) return Status::invalid_shape;
+      break;
+    case ResponseModel::empirical:
+      if (s == 0 || s % r.components != 0 || s / r.components > max_empirical_outcomes) return Status::invalid_shape;
+      break;
+    default: return Status::invalid_shape;
+  }
+  // Cells times values per cell must fit the 32-bit offsets of `ResponseTableView::lookup`.
+  std::uint64_t values = r.components > s ? r.components : s;
   for (std::uint32_t a = 0; a < r.axis_count; ++a) {
     if (!readable(r.axes[a])) return Status::invalid_shape;
     values *= r.axes[a].size;
     if (values > 0x7fffffffu) return Status::invalid_shape;
   }
-  if (!readable(r.mean) || !readable(r.stddev)) return Status::invalid_shape;
+  if (!readable(r.mean) || !readable(r.spread)) return Status::invalid_shape;
   const RestPosesView<D>& rest = sig.rest;
   if (rest.count > max_rest_poses) return Status::invalid_shape;
   if (rest.count > 0 && (rest.normals == nullptr || rest.heights == nullptr || rest.frequencies == nullptr))
@@ -120,15 +133,17 @@ Status check_signature_values(const SignatureView<D>& sig)
   for (std::uint32_t i = 0; i < h.spin_ratio.size; ++i)
     if (bad(h.mean[i]) || !(h.mean[i] > 0) || bad(h.stddev[i])) return Status::invalid_shape;
   const ResponseTableView& r = sig.response;
-  std::uint32_t values = r.components;
+  std::uint32_t cells = 1;
   for (std::uint32_t a = 0; a < r.axis_count; ++a) {
     if (bad_axis(r.axes[a])) return Status::invalid_shape;
-    values *= r.axes[a].size;
+    cells *= r.axes[a].size;
   }
-  if (bad(r.mean.scale) || bad(r.mean.offset) || bad(r.stddev.scale) || bad(r.stddev.offset))
+  if (bad(r.mean.scale) || bad(r.mean.offset) || bad(r.spread.scale) || bad(r.spread.offset))
     return Status::invalid_shape;
-  for (std::uint32_t i = 0; i < values; ++i)
-    if (bad(r.mean[i]) || bad(r.stddev[i])) return Status::invalid_shape;
+  for (std::uint32_t i = 0; i < cells * r.components; ++i)
+    if (bad(r.mean[i])) return Status::invalid_shape;
+  for (std::uint32_t i = 0; i < cells * r.spread_per_cell; ++i)
+    if (bad(r.spread[i])) return Status::invalid_shape;
   for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
     const typename Space<D>::Vec n = sig.rest.normal(i);
     if (!finite(n) || !(std::fabs(n.squaredNorm() - 1) < Scalar(2e-3))) return Status::invalid_shape;

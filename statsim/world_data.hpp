@@ -125,15 +125,14 @@ std::uint64_t signature_hash(const SignatureView<D>& sig)
   hash_values(h, sig.height.mean, sig.height.spin_ratio.size);
   hash_values(h, sig.height.stddev, sig.height.spin_ratio.size);
   const ResponseTableView& r = sig.response;
-  h.add(r.axis_count);
-  h.add(r.components);
-  std::uint32_t values = r.components;
+  h.add_all(r.axis_count, r.components, std::uint8_t(r.model), r.spread_per_cell);
+  std::uint32_t cells = 1;
   for (std::uint32_t a = 0; a < r.axis_count; ++a) {
     hash_axis(h, r.axes[a]);
-    values *= r.axes[a].size;
+    cells *= r.axes[a].size;
   }
-  hash_values(h, r.mean, values);
-  hash_values(h, r.stddev, values);
+  hash_values(h, r.mean, cells * r.components);
+  hash_values(h, r.spread, cells * r.spread_per_cell);
   h.add(sig.rest.count);
   for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
     h.add_vec(sig.rest.normal(i));

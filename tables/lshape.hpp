@@ -14,11 +14,11 @@
 
 #include "statsim/signature.hpp"
 
-static_assert(STATSIM_TABLE_FORMAT_VERSION == 1, "tables/lshape.hpp was generated for table format 1: regenerate it with the command above");
+static_assert(STATSIM_TABLE_FORMAT_VERSION == 2, "tables/lshape.hpp was generated for table format 2: regenerate it with the command above");
 
 namespace statsim::tables {
 
-inline constexpr Signature<3, 16, 7, 10, 16, 1, 3> lshape = {
+inline constexpr Signature<3, 16, 7, 10, 16, 1, 3, 6> lshape = {
     "lshape",
     0x1.186f18p-3f,  // length L, m
     0x1.186f18p-3f,  // bounding radius, m
@@ -27,6 +27,7 @@ inline constexpr Signature<3, 16, 7, 10, 16, 1, 3> lshape = {
     {0x1.333334p-2f, 0x1p-1f, 0x1.99999ap-5f},  // material
     0x1.47ae14p-6f,  // restitution threshold, m/s
     statsim::ResponseLayout::scaled,
+    statsim::ResponseModel::independent_gaussian,
     3u,  // response axes
     // h_coll: spin ratio, mean, std (m)
     {{

@@ -24,12 +24,12 @@
 
 #include "statsim/signature.hpp"
 
-static_assert(STATSIM_TABLE_FORMAT_VERSION == 1, "tables/square2d.hpp was generated for table format 1: regenerate it with the command above");
+static_assert(STATSIM_TABLE_FORMAT_VERSION == 2, "tables/square2d.hpp was generated for table format 2: regenerate it with the command above");
 
 namespace statsim::tables {
 
 // Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses>
-inline constexpr Signature<2, 16, 7, 9, 5, 1, 4> square2d = {
+inline constexpr Signature<2, 16, 7, 9, 5, 1, 4, 3> square2d = {
     "square2d",
     0x1.6a09e6p-1f,  // length L (bounding radius), m
     0x1.6a09e6p-1f,  // bounding_radius, m
@@ -38,6 +38,7 @@ inline constexpr Signature<2, 16, 7, 9, 5, 1, 4> square2d = {
     {0x1.333334p-2f, 0x1p-1f, 0x1.99999ap-5f},  // material: restitution, friction, rolling
     0x1p+0f,  // restitution_threshold, m/s
     ResponseLayout::with_speed,
+    ResponseModel::independent_gaussian,
     3,  // axis_count
     // height_axis: spin ratio |w| L / |v|
     {{

@@ -82,7 +82,7 @@ HeaderNumbers loaded_numbers(const LoadedSignature3& loaded)
                                             &s.axis2, &s.axis3})
           add_floats(n, *v);
         add_responses(n, s.response_mean);
-        add_responses(n, s.response_stddev);
+        add_responses(n, s.response_spread);
         for (const std::vector<float>* v : {&s.rest_normals, &s.rest_heights, &s.rest_frequencies}) add_floats(n, *v);
       },
       loaded.tables);

@@ -121,7 +121,7 @@ void check_committed_table(const Sig& table, double h_min, double h_max, std::si
   const std::uint32_t n = table.cells * 3;
   for (std::uint32_t i = 0; i < n; ++i) {
     CHECK(std::isfinite(v.response.mean[i]));
-    CHECK(v.response.stddev[i] >= 0.0f);
+    CHECK(v.response.spread[i] >= 0.0f);
   }
   REQUIRE(v.rest.count == poses);
   double total = 0.0;

@@ -241,8 +241,8 @@ TEST_CASE("gather3d: i16 tables dequantize within the reported error")
   const double worst = j["response"]["i16"]["worst_error"].get<double>();
   const float mean_scale = j["response"]["i16"]["mean_scale"].get<float>();
   const float mean_offset = j["response"]["i16"]["mean_offset"].get<float>();
-  const float std_scale = j["response"]["i16"]["std_scale"].get<float>();
-  const float std_offset = j["response"]["i16"]["std_offset"].get<float>();
+  const float std_scale = j["response"]["i16"]["spread_scale"].get<float>();
+  const float std_offset = j["response"]["i16"]["spread_offset"].get<float>();
   CHECK(text.find("i16 dequantization error") != std::string::npos);
   const HeaderNumbers h = header_numbers(text);
   // Integers: axis_count 3u, then the two tables of 8 cells x 6.
@@ -274,7 +274,7 @@ TEST_CASE("gather3d: i16 tables dequantize within the reported error")
                                                    "static_assert(statsim::tables::box.response_mean.q.size() == 48);\n");
   const std::string use = dir.write("use.cpp", "#include \"tiny16.hpp\"\n"
                                                "constexpr statsim::SignatureView<3> v = statsim::tables::box.view();\n"
-                                               "static_assert(!v.response.mean.f32 && !v.response.stddev.f32);\n"
+                                               "static_assert(!v.response.mean.f32 && !v.response.spread.f32);\n"
                                                "static_assert(v.response.mean.scale > 0 && v.rest.count >= 1);\n");
   const std::string compile = std::string(STATSIM_TEST_CXX) + " -std=c++17 -fsyntax-only -Wall -Wextra -Wpedantic -Wshadow " +
                               "-Wconversion -Werror -I" + STATSIM_TEST_SOURCE_DIR + " -isystem " +

@@ -139,11 +139,15 @@ TEST_CASE("no heap allocation in construction and stepping of a 10000-body stati
   Eigen::internal::set_is_malloc_allowed(false);
   g_counting = true;
   auto* w = new (storage_big) World3<N_big>();
+  // One shape of each response model.
   REQUIRE(w->add_shape(statsim::testing::cube_synthetic.view()).ok());
+  REQUIRE(w->add_shape(statsim::testing::cube_correlated_synthetic.view()).ok());
+  REQUIRE(w->add_shape(statsim::testing::cube_empirical_synthetic.view()).ok());
   REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
   Pcg32 g(3, 4);
   for (std::uint32_t i = 0; i < N_big; ++i) {
     BodyDef3 b;
+    b.shape = ShapeId(i % 3);
     b.position = Vector3(g.uniform(-5, 5), g.uniform(-5, 5), g.uniform(0.2f, 3));
     b.angular_velocity = Vector3(g.uniform(-5, 5), 0, g.uniform(-5, 5));
     REQUIRE(w->add_body(b).ok());

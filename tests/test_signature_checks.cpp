@@ -37,7 +37,7 @@ std::vector<Mutation<D>> missing_pointers(const SignatureView<D>& valid)
     m.push_back({"response axis size " + std::to_string(a), [a](SignatureView<D>& v) { v.response.axes[a].size = 0; }});
   }
   m.push_back({"response mean", [](SignatureView<D>& v) { v.response.mean.f32 = nullptr; v.response.mean.i16 = nullptr; }});
-  m.push_back({"response stddev", [](SignatureView<D>& v) { v.response.stddev.f32 = nullptr; v.response.stddev.i16 = nullptr; }});
+  m.push_back({"response stddev", [](SignatureView<D>& v) { v.response.spread.f32 = nullptr; v.response.spread.i16 = nullptr; }});
   m.push_back({"rest normals", [](SignatureView<D>& v) { v.rest.normals = nullptr; }});
   m.push_back({"rest heights", [](SignatureView<D>& v) { v.rest.heights = nullptr; }});
   m.push_back({"rest frequencies", [](SignatureView<D>& v) { v.rest.frequencies = nullptr; }});
@@ -113,4 +113,50 @@ TEST_CASE("add_shape rejects rest frequencies that are not finite or outside [0,
     CHECK(w.add_shape(v).status == Status::invalid_shape);
     CHECK(w.shape_count() == 0);
   }
+}
+
+TEST_CASE("add_shape rejects response-model data that does not fit its model, with the world unchanged")
+{
+  const SignatureView<3> paper = testing::cube_synthetic.view();
+  const SignatureView<3> correlated = testing::cube_correlated_synthetic.view();
+  const SignatureView<3> empirical = testing::cube_empirical_synthetic.view();
+  std::vector<Mutation<3>> m;
+  m.push_back({"unknown model", [](SignatureView<3>& v) { v.response.model = ResponseModel(3); }});
+  m.push_back({"model byte 255", [](SignatureView<3>& v) { v.response.model = ResponseModel(255); }});
+  m.push_back({"no spread values", [](SignatureView<3>& v) { v.response.spread_per_cell = 0; }});
+  m.push_back({"another model's spread size", [](SignatureView<3>& v) {
+                 v.response.spread_per_cell = v.response.model == ResponseModel::correlated_gaussian ? 6 : 21;
+               }});
+  m.push_back({"a spread that is not a whole number of outcomes", [](SignatureView<3>& v) {
+                 if (v.response.model == ResponseModel::empirical) v.response.spread_per_cell = 23;
+                 else v.response.spread_per_cell += 1;
+               }});
+  World3<4> w;
+  expect_all_rejected<3>(w, paper, m);
+  expect_all_rejected<3>(w, correlated, m);
+  expect_all_rejected<3>(w, empirical, m);
+  // An empirical table of more outcomes than the runtime's limit.
+  SignatureView<3> many = empirical;
+  many.response.spread_per_cell = 6 * (max_empirical_outcomes + 1);
+  const std::uint32_t shapes = w.shape_count();
+  CHECK(w.add_shape(many).status == Status::invalid_shape);
+  CHECK(w.shape_count() == shapes);
+
+  // A value that is not finite in the spread of either new model.
+  for (const SignatureView<3>* valid : {&correlated, &empirical}) {
+    const std::uint32_t n = 8 * valid->response.spread_per_cell;
+    std::vector<Scalar> spread(valid->response.spread.f32, valid->response.spread.f32 + n);
+    spread[n / 2] = std::numeric_limits<Scalar>::quiet_NaN();
+    SignatureView<3> v = *valid;
+    v.response.spread.f32 = spread.data();
+    World3<4> w2;
+    CHECK(w2.add_shape(v).status == Status::invalid_shape);
+    CHECK(w2.shape_count() == 0);
+  }
+  // The 16-bit forms of both are accepted.
+  static constexpr auto correlated16 = quantize16(testing::cube_correlated_synthetic);
+  static constexpr auto empirical16 = quantize16(testing::cube_empirical_synthetic);
+  World3<4> w3;
+  CHECK(w3.add_shape(correlated16.view()).ok());
+  CHECK(w3.add_shape(empirical16.view()).ok());
 }

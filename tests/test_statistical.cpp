@@ -43,7 +43,7 @@ Sig3 make_sig3()
       for (Scalar x2 : s.axis2)
         for (std::uint32_t c = 0; c < 6; ++c, ++k) {
           s.response_mean[k] = linear(c, x0, x1, x2);
-          s.response_stddev[k] = Scalar(0.02) + Scalar(0.005) * Scalar(c);
+          s.response_spread[k] = Scalar(0.02) + Scalar(0.005) * Scalar(c);
         }
   s.rest_normals = {0, 0, 1};
   s.rest_heights = {0.25f};

@@ -80,24 +80,29 @@ void fuzz_signature(Input& in)
     v.response.axes[a] = AxisView{n ? t.axes[a].data() : nullptr, n};
     cells *= n;
   }
-  // Tables hold cells x components values, as a generated table does (lookups must stay inside).
+  // Any model byte (3 is none); the spread's size is its model's, or any, as a hand-made view's
+  // may be. Tables hold cells x that many values, as a generated table does (lookups must stay
+  // inside).
+  v.response.model = ResponseModel(in.below(4));
+  v.response.spread_per_cell = in.below(8) ? response_spread_size(v.response.model, components, 1 + in.below(3))
+                                           : in.below(64);
   const std::uint32_t values = cells * components;
+  const std::uint32_t spreads = cells * v.response.spread_per_cell;
   const bool q16 = in.below(2) != 0;
   for (std::uint32_t i = 0; i < values; ++i) {
-    if (q16) {
-      t.mean16.push_back(std::int16_t(in.byte() << 8 | in.byte()));
-      t.stddev16.push_back(std::int16_t(in.byte() << 8 | in.byte()));
-    } else {
-      t.mean.push_back(in.value(4));
-      t.stddev.push_back(in.value(1));
-    }
+    if (q16) t.mean16.push_back(std::int16_t(in.byte() << 8 | in.byte()));
+    else t.mean.push_back(in.value(4));
+  }
+  for (std::uint32_t i = 0; i < spreads; ++i) {
+    if (q16) t.stddev16.push_back(std::int16_t(in.byte() << 8 | in.byte()));
+    else t.stddev.push_back(in.value(1));
   }
   if (q16) {
     v.response.mean = ValuesView{nullptr, values ? t.mean16.data() : nullptr, in.value(0.01f), in.value(1)};
-    v.response.stddev = ValuesView{nullptr, values ? t.stddev16.data() : nullptr, in.value(0.01f), in.value(1)};
+    v.response.spread = ValuesView{nullptr, spreads ? t.stddev16.data() : nullptr, in.value(0.01f), in.value(1)};
   } else {
     v.response.mean.f32 = values ? t.mean.data() : nullptr;
-    v.response.stddev.f32 = values ? t.stddev.data() : nullptr;
+    v.response.spread.f32 = spreads ? t.stddev.data() : nullptr;
   }
   const std::uint32_t nr = in.below(4);
   for (std::uint32_t i = 0; i < nr; ++i) {

@@ -658,10 +658,11 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
          " drops, frequency " + fmt("%.4f", c.frequency) + "\n";
   }
   s += table_prologue(o.name);
-  s += "// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses>\n";
+  s += "// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,\n"
+       "//           spread values per cell (the paper's model: one standard deviation per component)>\n";
   s += table_definition("Signature<2, " + std::to_string(r.heights.size()) + ", " + std::to_string(o.cos_thetas.size()) +
                             ", " + std::to_string(o.signed_spins.size()) + ", " + std::to_string(o.speeds.size()) +
-                            ", 1, " + std::to_string(kept.size()) + ">",
+                            ", 1, " + std::to_string(kept.size()) + ", 3>",
                         o.name);
   statsim::Material defaults;
   const auto array = [&s](const std::string& comment, const std::vector<double>& values) {
@@ -677,6 +678,7 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
                    "material: restitution, friction, rolling");
   s += table_entry(hex_float(static_cast<double>(r.restitution_threshold)), "restitution_threshold, m/s");
   s += table_entry("ResponseLayout::with_speed");
+  s += table_entry("ResponseModel::independent_gaussian");
   s += table_entry("3", "axis_count");
   std::vector<double> hm, hsd;
   for (const HeightRow& h : r.heights) {
@@ -698,7 +700,7 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
     }
   }
   array("response_mean: per cell (cos theta slowest, then spin, then speed) w+ L/|V-|, dv_x/|V-|, dv_y/|V-|", rm);
-  array("response_stddev", rs);
+  array("response_spread: per cell the standard deviation of each component", rs);
   std::vector<double> rn, rh, rf;
   for (const RestCluster& c : kept) {
     rn.push_back(c.normal.x);

@@ -168,6 +168,10 @@ void validate_gather_options(const GatherOptions& o)
   if (!(o.rolling_resistance >= 0)) fail("--rolling-resistance must be >= 0");
   if (!(o.rest_tolerance_deg > 0 && o.rest_tolerance_deg < 90)) fail("--rest-tolerance must be in (0, 90) degrees");
   if (!(o.rest_min_frequency >= 0 && o.rest_min_frequency < 1)) fail("--rest-min-frequency must be in [0, 1)");
+  if (o.response_model == ResponseModel::empirical &&
+      (o.empirical_outcomes < 1 || o.empirical_outcomes > o.trials ||
+       o.empirical_outcomes > static_cast<int>(max_empirical_outcomes)))
+    fail("--empirical-outcomes must be in [1, min(--trials, " + std::to_string(max_empirical_outcomes) + ")]");
   if (!(o.max_impact_time > 0) || !(o.max_drop_time > 0) || !(o.still_time > 0) || !(o.still_speed > 0))
     fail("time limits and the stillness threshold must be positive");
   auto axis = [&](const std::vector<double>& v, const char* what, double lo, double hi) {
@@ -514,6 +518,91 @@ GatherResult gather(const GatherOptions& options)
   return r;
 }
 
+// ---- response models ---------------------------------------------------------------------------
+
+const char* response_model_name(ResponseModel model)
+{
+  switch (model) {
+    case ResponseModel::independent_gaussian: return "paper";
+    case ResponseModel::correlated_gaussian: return "correlated";
+    case ResponseModel::empirical: return "empirical";
+  }
+  return "unknown";
+}
+
+ResponseModel parse_response_model(const std::string& name)
+{
+  for (ResponseModel m :
+       {ResponseModel::independent_gaussian, ResponseModel::correlated_gaussian, ResponseModel::empirical})
+    if (name == response_model_name(m)) return m;
+  throw std::runtime_error("unknown response model '" + name + "' (paper, correlated or empirical)");
+}
+
+std::vector<double> cholesky_lower(const std::vector<double>& a, int n)
+{
+  std::vector<double> l(static_cast<std::size_t>(n * n), 0.0);
+  double largest = 0.0;
+  for (int i = 0; i < n; ++i) largest = std::max(largest, a[static_cast<std::size_t>(i * n + i)]);
+  const double tiny = 1e-12 * largest;
+  // Column by column: l_jj = sqrt(a_jj - sum_k l_jk^2), l_ij = (a_ij - sum_k l_ik l_jk) / l_jj.
+  for (int j = 0; j < n; ++j) {
+    double d = a[static_cast<std::size_t>(j * n + j)];
+    for (int k = 0; k < j; ++k) d -= l[static_cast<std::size_t>(j * n + k)] * l[static_cast<std::size_t>(j * n + k)];
+    if (!(d > tiny)) continue;  // no variance left in this direction: a zero column
+    const double ljj = std::sqrt(d);
+    l[static_cast<std::size_t>(j * n + j)] = ljj;
+    for (int i = j + 1; i < n; ++i) {
+      double x = a[static_cast<std::size_t>(i * n + j)];
+      for (int k = 0; k < j; ++k) x -= l[static_cast<std::size_t>(i * n + k)] * l[static_cast<std::size_t>(j * n + k)];
+      l[static_cast<std::size_t>(i * n + j)] = x / ljj;
+    }
+  }
+  std::vector<double> packed;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j <= i; ++j) packed.push_back(l[static_cast<std::size_t>(i * n + j)]);
+  return packed;
+}
+
+std::vector<double> response_spread(const GatherResult& r)
+{
+  const GatherOptions& o = r.options;
+  if (o.response_model == ResponseModel::independent_gaussian) return r.response_std;
+  const std::size_t cells = r.response_mean.size() / 6;
+  if (r.cell_outcomes.size() != cells)
+    throw std::runtime_error(std::string("the ") + response_model_name(o.response_model) +
+                             " response model needs every cell's trial outcomes");
+  std::vector<double> out;
+  for (std::size_t cell = 0; cell < cells; ++cell) {
+    const std::vector<Response>& t = r.cell_outcomes[cell];
+    if (o.response_model == ResponseModel::correlated_gaussian) {
+      std::vector<double> cov(36, 0.0);
+      const double* mean = &r.response_mean[cell * 6];
+      for (const Response& x : t)
+        for (int i = 0; i < 6; ++i)
+          for (int j = 0; j < 6; ++j) cov[static_cast<std::size_t>(i * 6 + j)] += (x[i] - mean[i]) * (x[j] - mean[j]);
+      const double n1 = t.size() > 1 ? static_cast<double>(t.size() - 1) : 1.0;
+      for (double& c : cov) c /= n1;
+      const std::vector<double> l = cholesky_lower(cov, 6);
+      out.insert(out.end(), l.begin(), l.end());
+    } else {
+      const std::size_t k = static_cast<std::size_t>(o.empirical_outcomes);
+      if (t.size() < k) throw std::runtime_error("a cell has fewer outcomes than --empirical-outcomes");
+      // Ranks by the normal velocity offset (component 5), ties by trial order: a stable sort.
+      std::vector<std::size_t> order(t.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::stable_sort(order.begin(), order.end(), [&t](std::size_t a, std::size_t b) { return t[a][5] < t[b][5]; });
+      std::vector<Response> kept;
+      for (std::size_t i = 0; i < k; ++i) kept.push_back(t[order[(2 * i + 1) * t.size() / (2 * k)]]);
+      Response centre{};
+      for (const Response& x : kept)
+        for (int c = 0; c < 6; ++c) centre[c] += x[c] / static_cast<double>(k);
+      for (const Response& x : kept)
+        for (int c = 0; c < 6; ++c) out.push_back(x[c] - centre[c]);
+    }
+  }
+  return out;
+}
+
 // ---- output ----------------------------------------------------------------------------------
 
 Quantized quantize(const std::vector<float>& values)
@@ -585,7 +674,11 @@ std::vector<std::string> option_lines(const GatherResult& r)
   l.push_back("layout " + std::string(o.with_speed ? "with_speed (cos theta, cos phi, |V-|, spin ratio)"
                                                      : "scaled (cos theta, cos phi, spin ratio)") +
               (o.with_speed ? "" : ", impacts at |V-| = " + num(o.speed) + " m/s") + "; precision " +
-              (o.i16 ? "i16" : "f32") + "; seed " + std::to_string(o.seed));
+              (o.i16 ? "i16" : "f32") + "; seed " + std::to_string(o.seed) + "; response model " +
+              response_model_name(o.response_model) +
+              (o.response_model == ResponseModel::empirical
+                   ? " (" + std::to_string(o.empirical_outcomes) + " outcomes a cell)"
+                   : std::string()));
   l.push_back("restitution " + num(s.restitution) + ", friction " + num(s.friction) + ", restitution threshold " +
               num(s.restitution_threshold) + " m/s, rolling resistance (runtime only) " + num(o.rolling_resistance));
   l.push_back("dt " + num(s.dt) + " s, " + std::to_string(s.solver_iterations) + " solver iterations, warm starting " +
@@ -626,11 +719,13 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << "// Rest poses (body-frame up, height, frequency):";
   for (const RestPose& p : r.rest) h << " " << vec3(p.normal, "%.4f") << " " << fmt("%.5f", p.height) << " m " << fmt("%.3f", p.frequency) << ";";
   h << "\n";
+  const std::vector<double> spread = response_spread(r);
+  const std::size_t spread_size = spread.size() / std::max<std::size_t>(1, r.response_mean.size() / 6);
   Quantized qm, qs;
   if (o.i16) {
     qm = quantize(to_float(r.response_mean));
-    qs = quantize(to_float(r.response_std));
-    h << "// i16 dequantization error: mean table " << fmt("%.3g", qm.worst_error) << ", std table "
+    qs = quantize(to_float(spread));
+    h << "// i16 dequantization error: mean table " << fmt("%.3g", qm.worst_error) << ", spread table "
       << fmt("%.3g", qs.worst_error) << " (worst " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << ")\n";
   }
   h << table_prologue(o.name);
@@ -639,7 +734,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
                             std::to_string(r.height_mean.size()) + ", " + std::to_string(a0) + ", " +
                             std::to_string(a1) + ", " + std::to_string(a2) + ", " + std::to_string(a3) + ", " +
-                            std::to_string(r.rest.size()) + ">",
+                            std::to_string(r.rest.size()) + ", " + std::to_string(spread_size) + ">",
                         o.name);
   // Short arrays on one line, long ones 8 values a line (response tables 6, one cell; normals 3).
   const auto array = [](const std::vector<double>& v, std::size_t per_line = 8) {
@@ -654,6 +749,8 @@ std::string header_text(const GatherResult& r, const std::string& command)
                    "material");
   h << table_entry(hex_float(o.reference.restitution_threshold), "restitution threshold, m/s");
   h << table_entry(std::string("statsim::ResponseLayout::") + (o.with_speed ? "with_speed" : "scaled"));
+  const char* model_enum[] = {"independent_gaussian", "correlated_gaussian", "empirical"};
+  h << table_entry(std::string("statsim::ResponseModel::") + model_enum[static_cast<int>(o.response_model)]);
   h << table_entry(std::to_string(r.axes.size()) + "u", "response axes");
   h << table_comment("h_coll: spin ratio, mean, std (m)");
   h << table_entry(array(o.height_ratios));
@@ -662,15 +759,19 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << table_comment(std::string("response axes: cos theta, cos phi, ") + (o.with_speed ? "speed (m/s), " : "") +
                      "spin ratio" + (o.with_speed ? "" : ", (unused)"));
   for (std::size_t a = 0; a < 4; ++a) h << table_entry(array(a < r.axes.size() ? r.axes[a] : std::vector<double>{0.0}));
-  h << table_comment("response mean, then std, per cell: w_x, w_y, w_z (W+ L/|V-|), dv_x, dv_y, dv_z ((V+ - V_particle+)/|V-|)");
+  const char* spread_text[] = {"std per component",
+                               "Cholesky factor of the covariance, lower triangle row by row",
+                               "stored outcomes minus their mean, one after another"};
+  h << table_comment("response mean per cell: w_x, w_y, w_z (W+ L/|V-|), dv_x, dv_y, dv_z ((V+ - V_particle+)/|V-|)");
+  h << table_comment(std::string("then the spread per cell: ") + spread_text[static_cast<int>(o.response_model)]);
   if (o.i16) {
     // statsim::Quantized16: {scale, offset, {{values}}}.
     for (const Quantized* q : {&qm, &qs})
       h << table_entry("{" + hex_floats({q->scale, q->offset}) + ", " + int_array(q->q, ArrayStyle{6, 6, false}) + "}",
-                       q == &qm ? "mean: scale, offset, values" : "std: scale, offset, values");
+                       q == &qm ? "mean: scale, offset, values" : "spread: scale, offset, values");
   } else {
     h << table_entry(array(r.response_mean, 6));
-    h << table_entry(array(r.response_std, 6));
+    h << table_entry(array(spread, 6));
   }
   std::vector<double> normals, heights, freqs;
   for (const RestPose& p : r.rest) {
@@ -737,22 +838,25 @@ std::string json_text(const GatherResult& r, const std::string& command)
   const char* names3[] = {"cos_theta", "cos_phi", "spin_ratio"};
   for (std::size_t a = 0; a < r.axes.size(); ++a)
     axes.push_back({{"name", r.axes.size() == 4 ? names4[a] : names3[a]}, {"values", fl(r.axes[a])}});
+  const std::vector<double> spread = response_spread(r);
   json resp = {{"layout", o.with_speed ? "with_speed" : "scaled"},
+               {"model", response_model_name(o.response_model)},
                {"speed", o.with_speed ? json(nullptr) : json(o.speed)},
                {"axes", axes},
                {"components", {"w_x", "w_y", "w_z", "dv_x", "dv_y", "dv_z"}},
                {"mean", fl(r.response_mean)},
                {"std", fl(r.response_std)},
+               {"spread", fl(spread)},
                {"trials_per_cell", o.trials},
                {"trials", r.response_trials},
                {"time_limited", r.time_limited},
                {"max_penetration", r.max_penetration}};
   if (o.i16) {
-    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
+    const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(spread));
     resp["i16"] = {{"mean_scale", static_cast<double>(qm.scale)},
                    {"mean_offset", static_cast<double>(qm.offset)},
-                   {"std_scale", static_cast<double>(qs.scale)},
-                   {"std_offset", static_cast<double>(qs.offset)},
+                   {"spread_scale", static_cast<double>(qs.scale)},
+                   {"spread_offset", static_cast<double>(qs.offset)},
                    {"worst_error", std::max(qm.worst_error, qs.worst_error)}};
   }
   j["response"] = resp;

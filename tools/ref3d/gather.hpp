@@ -26,6 +26,7 @@
 
 #include "ref3d/model.hpp"
 #include "ref3d/reference.hpp"
+#include "statsim/signature.hpp"
 
 #include <array>
 #include <cstdint>
@@ -53,6 +54,10 @@ struct GatherOptions {
   int rest_drops = 1000;
   std::uint64_t seed = 1;
   bool i16 = false;           ///< --precision i16
+  /// How each cell's spread is stored (--response-model): see statsim::ResponseModel.
+  ResponseModel response_model = ResponseModel::independent_gaussian;
+  /// Outcomes kept per cell by the empirical model (--empirical-outcomes), 1 to `trials`.
+  int empirical_outcomes = 16;
   unsigned threads = 0;       ///< 0 = all hardware threads
   bool progress = false;      ///< progress and ETA on stderr
   double density = 1000.0;    ///< kg/m^3
@@ -121,6 +126,27 @@ struct GatherResult {
 
 /// Runs the gathering (deterministic for a given options.seed, whatever options.threads).
 GatherResult gather(const GatherOptions& options);
+
+/// The command-line name of a response model ("paper", "correlated", "empirical").
+const char* response_model_name(ResponseModel model);
+/// The model of a command-line name; throws std::runtime_error listing the names.
+ResponseModel parse_response_model(const std::string& name);
+
+/// The spread values of every cell (cells x statsim::response_spread_size), by the model of
+/// `r.options`, from `r.cell_outcomes` (the paper's model: `r.response_std`):
+///  - correlated: the lower triangle, row by row, of the Cholesky factor of the cell's sample
+///    covariance (n - 1); a direction without variance gets a zero column.
+///  - empirical: `empirical_outcomes` of the cell's outcomes, picked at evenly spaced ranks of
+///    the normal velocity offset (so the kept outcomes span its distribution, the other
+///    components coming with them), each minus the mean of the kept ones (a draw's mean is then
+///    the table's mean).
+/// Throws std::runtime_error when a model needs outcomes that `r` lacks.
+std::vector<double> response_spread(const GatherResult& r);
+
+/// Lower triangle, row by row, of a Cholesky factor of the symmetric positive semi-definite
+/// n x n matrix `a` (row-major); a pivot not above 1e-12 times the largest diagonal is taken
+/// as 0 with its column.
+std::vector<double> cholesky_lower(const std::vector<double>& a, int n);
 
 /// One response trial (exposed for the checks and tests): cell coordinates, speed, trial index.
 struct ResponseTrial {

@@ -38,6 +38,7 @@ struct GatherCommand {
   GatherOptions options;
   std::string layout = "scaled";
   std::string precision = "f32";
+  std::string response_model = "paper";
   std::string mesh_shape = "gimpact";
   std::string out;
   std::string json;
@@ -159,6 +160,7 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.progress = !c.quiet;
     o.with_speed = c.layout == "paper";
     o.i16 = c.precision == "i16";
+    o.response_model = parse_response_model(c.response_model);
     o.reference.mesh_hull = c.mesh_shape == "hull";
     validate_gather_options(o);
     if (c.speed_check || c.step_check || c.settings_check) {
@@ -237,6 +239,15 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   sub->add_option("--seed", o.seed, "Random seed (same seed, same bytes, any --threads)")->capture_default_str();
   sub->add_option("--precision", c->precision, "Response tables as f32 or as i16 with per-table scale and offset")
       ->check(CLI::IsMember({"f32", "i16"}))
+      ->capture_default_str();
+  sub->add_option("--response-model", c->response_model,
+                  "How a cell's spread is stored: paper = a standard deviation per component (independent "
+                  "Gaussians, paper 3.2.2); correlated = a Cholesky factor of the 6x6 covariance; empirical = "
+                  "--empirical-outcomes stored trial outcomes")
+      ->check(CLI::IsMember({"paper", "correlated", "empirical"}))
+      ->capture_default_str();
+  sub->add_option("--empirical-outcomes", o.empirical_outcomes,
+                  "Outcomes stored per cell by --response-model empirical (1 to --trials, at most 64)")
       ->capture_default_str();
   sub->add_option("--out", c->out, "Output header (tables/NAME.hpp); with a check, the report");
   sub->add_option("--json", c->json, "Also dump the signature as JSON to this file");

@@ -54,22 +54,24 @@ void expect_size(const std::vector<Scalar>& v, std::size_t n, const std::string&
 }
 
 // Response tables as floats.
-void set_responses(BasicLoadedSignature3<std::vector<Scalar>>& s, std::vector<Scalar> mean, std::vector<Scalar> stddev,
+void set_responses(BasicLoadedSignature3<std::vector<Scalar>>& s, std::vector<Scalar> mean, std::vector<Scalar> spread,
                    const json&, const std::string&)
 {
   s.response_mean = std::move(mean);
-  s.response_stddev = std::move(stddev);
+  s.response_spread = std::move(spread);
 }
 
 // Response tables as 16-bit integers, by the generator's rule (statsim::quantize16), which must
 // give the scales and offsets that `i16` states.
-void set_responses(BasicLoadedSignature3<LoadedQuantized16>& s, std::vector<Scalar> mean, std::vector<Scalar> stddev,
+void set_responses(BasicLoadedSignature3<LoadedQuantized16>& s, std::vector<Scalar> mean, std::vector<Scalar> spread,
                    const json& i16, const std::string& origin)
 {
   const Scalar mean_scale = number(i16, "mean_scale", origin, "response.i16.");
   const Scalar mean_offset = number(i16, "mean_offset", origin, "response.i16.");
-  const Scalar std_scale = number(i16, "std_scale", origin, "response.i16.");
-  const Scalar std_offset = number(i16, "std_offset", origin, "response.i16.");
+  // Files of table format 1 name the spread "std".
+  const bool old = !i16.contains("spread_scale");
+  const Scalar std_scale = number(i16, old ? "std_scale" : "spread_scale", origin, "response.i16.");
+  const Scalar std_offset = number(i16, old ? "std_offset" : "spread_offset", origin, "response.i16.");
   if (!(mean_scale > 0) || !(std_scale > 0)) fail(origin, "i16 scales must be positive");
   const auto quantized = [&](const std::vector<Scalar>& values, Scalar scale, Scalar offset, const char* table) {
     LoadedQuantized16 q;
@@ -81,7 +83,7 @@ void set_responses(BasicLoadedSignature3<LoadedQuantized16>& s, std::vector<Scal
     return q;
   };
   s.response_mean = quantized(mean, mean_scale, mean_offset, "mean");
-  s.response_stddev = quantized(stddev, std_scale, std_offset, "std");
+  s.response_spread = quantized(spread, std_scale, std_offset, "spread");
 }
 
 // Every part of `s` from the JSON `j`, checked in the order of the format.
@@ -129,11 +131,23 @@ void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::
     cells *= parts[a]->size();
   }
   if (want_axes == 3) s.axis3 = {0};
+  // Files without "model" (table format 1) hold the paper's model, their spread as "std".
+  s.model = ResponseModel::independent_gaussian;
+  if (r.contains("model")) {
+    const json& m = r.at("model");
+    if (m == "paper") s.model = ResponseModel::independent_gaussian;
+    else if (m == "correlated") s.model = ResponseModel::correlated_gaussian;
+    else if (m == "empirical") s.model = ResponseModel::empirical;
+    else fail(origin, "field 'response.model' is not \"paper\", \"correlated\" or \"empirical\"");
+  }
   std::vector<Scalar> mean = numbers(r, "mean", origin, "response.");
-  std::vector<Scalar> stddev = numbers(r, "std", origin, "response.");
+  std::vector<Scalar> spread = numbers(r, r.contains("spread") ? "spread" : "std", origin, "response.");
   expect_size(mean, cells * 6, "response.mean", origin);
-  expect_size(stddev, cells * 6, "response.std", origin);
-  set_responses(s, std::move(mean), std::move(stddev), r.contains("i16") ? r.at("i16") : json(), origin);
+  if (s.model != ResponseModel::empirical)
+    expect_size(spread, cells * response_spread_size(s.model, 6), "response.spread", origin);
+  else if (spread.empty() || spread.size() % (cells * 6) != 0)
+    fail(origin, "field 'response.spread' of an empirical table must hold whole outcomes for every cell");
+  set_responses(s, std::move(mean), std::move(spread), r.contains("i16") ? r.at("i16") : json(), origin);
 
   const json& rest = field(j, "rest", origin);
   if (!rest.is_array()) fail(origin, "field 'rest' is not an array");
@@ -171,8 +185,8 @@ std::size_t LoadedSignature3::bytes() const
 std::size_t signature_bytes(const SignatureView<3>& sig)
 {
   const std::size_t f = sizeof(Scalar);
-  // length, bounding radius, mass, 3 unit inertia, 3 material, restitution threshold; layout and
-  // axis count as two 4-byte words.
+  // length, bounding radius, mass, 3 unit inertia, 3 material, restitution threshold; layout
+  // and model (one byte each, in one padded 4-byte word) and the axis count.
   std::size_t bytes = 10 * f + 8;
   bytes += 3 * sig.height.spin_ratio.size * f;  // axis, mean, std
   std::size_t cells = 1;
@@ -180,9 +194,9 @@ std::size_t signature_bytes(const SignatureView<3>& sig)
     bytes += sig.response.axes[a].size * f;
     cells *= sig.response.axes[a].size;
   }
-  const std::size_t values = cells * sig.response.components;
+  const std::size_t values = cells * (sig.response.components + sig.response.spread_per_cell);
   const bool q16 = sig.response.mean.f32 == nullptr;
-  bytes += q16 ? 2 * values * sizeof(std::int16_t) + 4 * f : 2 * values * f;
+  bytes += q16 ? values * sizeof(std::int16_t) + 4 * f : values * f;
   bytes += sig.rest.count * (3 + 2) * f;  // normal, height, frequency
   return bytes;
 }

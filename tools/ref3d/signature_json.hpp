@@ -5,8 +5,9 @@
 //
 // Fields read: name, length, bounding_radius, mass, unit_inertia, material {restitution,
 // friction, rolling_resistance}, restitution_threshold, h_coll {ratio, mean, std},
-// response {layout, axes [{values}], mean, std, i16 {mean_scale, mean_offset, std_scale,
-// std_offset} (optional)}, rest [{normal, height, frequency}]. When the JSON has "i16", the
+// response {layout, model, axes [{values}], mean, spread, i16 {mean_scale, mean_offset,
+// spread_scale, spread_offset} (optional)}, rest [{normal, height, frequency}]. Files of table
+// format 1 (no "model"; "std" and std_scale / std_offset) load as the paper's model. When the JSON has "i16", the
 // response tables are quantised again by the generator's rule, statsim::quantize16 (which must
 // give the scales and offsets the JSON states), and used as 16-bit integers, as the generated
 // SignatureQ16 header stores them.
@@ -44,10 +45,11 @@ struct BasicLoadedSignature3 {
   Material material{};
   Scalar restitution_threshold = 0;
   ResponseLayout layout = ResponseLayout::scaled;
+  ResponseModel model = ResponseModel::independent_gaussian;
   std::uint32_t axis_count = 0;  ///< 3 (scaled) or 4 (with_speed)
   std::vector<Scalar> height_axis, height_mean, height_stddev;
   std::vector<Scalar> axis0, axis1, axis2, axis3;
-  Responses response_mean, response_stddev;
+  Responses response_mean, response_spread;
   std::vector<Scalar> rest_normals, rest_heights, rest_frequencies;
 
   SignatureView<3> view() const { return signature_view<3>(*this); }

@@ -100,16 +100,17 @@ Candidate response_error_with(const DenseTable& d, const std::vector<std::vector
   ResponseTableView view;
   view.axis_count = static_cast<std::uint32_t>(na);
   view.components = static_cast<std::uint32_t>(nc);
+  view.spread_per_cell = view.components;  // the paper's model: one standard deviation a component
   for (std::size_t a = 0; a < na; ++a)
     view.axes[a] = AxisView{cand_axes[a].data(), static_cast<std::uint32_t>(cand_axes[a].size())};
   if (i16) {
     qm = quantize(mean_f);
     qs = quantize(std_f);
     view.mean = ValuesView{nullptr, qm.q.data(), qm.scale, qm.offset};
-    view.stddev = ValuesView{nullptr, qs.q.data(), qs.scale, qs.offset};
+    view.spread = ValuesView{nullptr, qs.q.data(), qs.scale, qs.offset};
   } else {
     view.mean.f32 = mean_f.data();
-    view.stddev.f32 = std_f.data();
+    view.spread.f32 = std_f.data();
   }
 
   Candidate out;
