@@ -486,7 +486,9 @@ TEST_CASE("gather3d: the committed lshape and bunny tables")
     float total = 0.0f;
     for (std::uint32_t i = 0; i < v.rest.count; ++i) {
       CHECK(v.rest.normal(i).norm() == doctest::Approx(1.0).epsilon(1e-5));
-      CHECK(v.rest.frequencies[i] > 0.05f);
+      // Rare poses are kept too (a family above the cut, or while the dropped share is large), but
+      // each was seen in at least 5 of the 1000 drops.
+      CHECK(v.rest.frequencies[i] >= 0.005f);
       CHECK(v.rest.heights[i] > 0.0f);
       CHECK(v.rest.heights[i] < v.bounding_radius);
       total += v.rest.frequencies[i];
