@@ -272,6 +272,49 @@ TEST_CASE("gather2d: the L rests on its two arms and on its two tips")
   CHECK(diagonal == 1);
 }
 
+TEST_CASE("gather2d: rest poses equivalent under the shape's symmetry are kept together; the cut is an option")
+{
+  // The square's four sides are one family.
+  Gather2dOptions o;
+  o.shape = "square";
+  o.rest_drops = 200;
+  const Gather2dResult sq = run_rest_poses(o);
+  for (const RestCluster& c : sq.clusters) {
+    CHECK(c.family == 0);
+    CHECK(c.kept);
+  }
+  CHECK(sq.rest_dropped == 0.0);
+
+  // A 2 x 1 rectangle: the long sides (h = 0.5) and the short sides (h = 1) are two families. The
+  // default keeps both; a cut at 0.5 without the dropped-share rule keeps the long sides alone.
+  TempDir dir("gather2d");
+  const auto run = [&](std::vector<std::string> extra, const std::string& stem) {
+    std::vector<std::string> args = {"gather2d", "--polygon", "0,0 2,0 2,1 0,1", "--trials", "2", "--height-trials", "2",
+                                     "--rest-drops", "200", "--threads", "2", "--out", (dir.path / (stem + ".hpp")).string(),
+                                     "--json", (dir.path / (stem + ".json")).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    REQUIRE(run_command(args) == 0);
+    return nlohmann::json::parse(read_file((dir.path / (stem + ".json")).string()));
+  };
+  const auto kept = [](const nlohmann::json& j) {
+    std::vector<double> h;
+    for (const auto& c : j.at("rest_clusters"))
+      if (c.at("kept").get<bool>()) h.push_back(c.at("height").get<double>());
+    return h;
+  };
+  const nlohmann::json all = run({}, "all");
+  const nlohmann::json cut = run({"--rest-min-frequency", "0.5", "--rest-max-dropped", "1"}, "cut");
+  const std::vector<double> all_kept = kept(all), cut_kept = kept(cut);
+  CHECK(all_kept.size() == 4);
+  REQUIRE(cut_kept.size() == 2);
+  for (double h : cut_kept) CHECK(h == doctest::Approx(0.5));
+  CHECK(cut.at("rest_dropped").get<double>() > 0.0);
+  const std::string header = read_file((dir.path / "cut.hpp").string());
+  CHECK(header.find(" --rest-min-frequency 0.5 --rest-max-dropped 1") != std::string::npos);
+  CHECK(run_command({"gather2d", "--shape", "square", "--rest-min-frequency", "1", "--out",
+                     (dir.path / "x.hpp").string()}) != 0);
+}
+
 TEST_CASE("gather2d: the command rejects bad input with an error and writes nothing")
 {
   TempDir dir("gather2d");

@@ -1,5 +1,6 @@
 // tools/ref3d: the Bullet reference, `statsim gather` and the committed 3D tables.
 // Runs with the repository root as working directory (reads tools/meshes/*, tables/*).
+#include "common/rest_families.hpp"
 #include "common/table_writer.hpp"
 #include "ref3d/gather.hpp"
 #include "ref3d/model.hpp"
@@ -164,6 +165,111 @@ TEST_CASE("gather3d: a 1x2x4 box rests most often on a largest face")
   for (const RestPose& p : r.rest)
     if (std::fabs(p.height - 0.025) < 1e-4) largest_faces += p.frequency;
   CHECK(largest_faces > 0.5);
+  // A snapped pose stands exactly on its face: the height is the face's distance from the centre
+  // (a half extent), not the mean of the drops, which stop tilted by the solver's tolerance. Faces
+  // of one size are one family.
+  for (const RestPose& p : r.rest) {
+    REQUIRE(p.snapped);
+    const Eigen::Vector3d along = (m.boxes[0].rotation.transpose() * p.normal).cwiseAbs();
+    CHECK(std::fabs(p.height - along.dot(m.boxes[0].half_extents)) < 1e-12);
+    CHECK(std::fabs(p.measured_height - p.height) < 0.01 * p.height);
+    for (const RestPose& q : r.rest) CHECK((p.family == q.family) == (std::fabs(p.height - q.height) < 1e-9));
+  }
+}
+
+TEST_CASE("gather3d: rest poses equivalent under the shape's symmetry are kept or dropped together")
+{
+  // A nut: two flat faces at 36.5 % each, six equivalent side faces at 4.5 % each (27 % together),
+  // descriptors equal up to rounding; and one rare pose of its own kind.
+  const std::vector<double> flat = {0.4, 0.1, 0.3, 6, 12}, side = {0.8, 0.2, 0.1, 4, 12};
+  std::vector<RestCandidate> c;
+  for (int k = 0; k < 2; ++k) c.push_back({0.365, 365, flat});
+  for (int k = 0; k < 6; ++k) {
+    std::vector<double> d = side;
+    d[0] += 1e-9 * k;  // rounding
+    c.push_back({0.045, 45, d});
+  }
+  RestSelectionOptions o;
+  o.min_frequency = 0.05;
+  o.max_dropped = 1.0;  // the family rule alone
+  RestSelection s = select_rest_poses(c, o);
+  CHECK(s.family == std::vector<int>{0, 0, 1, 1, 1, 1, 1, 1});
+  CHECK(s.family_frequency[0] == doctest::Approx(0.73));
+  CHECK(s.family_frequency[1] == doctest::Approx(0.27));
+  // Every side is kept (the old rule, frequency > 0.05 pose by pose, kept only the two flats).
+  CHECK(std::count(s.kept.begin(), s.kept.end(), 1) == 8);
+  CHECK(s.dropped == 0.0);
+
+  // Sides that differ beyond the tolerance are not one family: each is below the cut alone.
+  std::vector<RestCandidate> unequal = c;
+  for (int k = 0; k < 6; ++k) unequal[2 + static_cast<std::size_t>(k)].descriptor[1] += 0.01 * k;
+  s = select_rest_poses(unequal, o);
+  CHECK(std::count(s.kept.begin(), s.kept.end(), 1) == 2);
+  CHECK(s.dropped == doctest::Approx(0.27));
+  // Descriptors of different lengths, or none, are never equivalent.
+  std::vector<RestCandidate> other = {{0.5, 50, {1, 2}}, {0.3, 30, {1, 2, 0}}, {0.1, 10, {}}, {0.1, 10, {}}};
+  CHECK(rest_families(other, 1e-3) == std::vector<int>{0, 1, 2, 3});
+
+  // The dropped-share rule: rare families, most frequent first, while more than max_dropped is
+  // dropped, each seen in at least min_count drops.
+  std::vector<RestCandidate> rare = {{0.60, 600, {1}}, {0.30, 300, {2}}, {0.04, 40, {3}}, {0.03, 30, {4}},
+                                     {0.025, 25, {5}}, {0.005, 5, {6}}};
+  o.max_dropped = 0.035;
+  o.min_count = 10;
+  s = select_rest_poses(rare, o);
+  CHECK(s.kept == std::vector<char>{1, 1, 1, 1, 0, 0});  // dropped 0.10, 0.06, then 0.03: stop
+  CHECK(s.dropped == doctest::Approx(0.03));
+  o.max_dropped = 0.0;
+  s = select_rest_poses(rare, o);
+  CHECK(s.kept == std::vector<char>{1, 1, 1, 1, 1, 0});  // the 5-drop pose is below min_count
+  // Never more poses than the runtime holds: a family that does not fit whole is not kept.
+  o.max_poses = 5;
+  s = select_rest_poses(c, o);
+  CHECK(std::count(s.kept.begin(), s.kept.end(), 1) == 2);
+}
+
+TEST_CASE("gather3d: --rest-min-frequency and --rest-max-dropped are options of the command")
+{
+  TempDir dir("gather3d");
+  // A 1 x 2 x 4 box: three families of two faces; the largest faces take most drops.
+  const std::vector<std::string> base = {"--box-size", "0.05,0.1,0.2", "--cos-theta", "1", "--cos-phi", "0",
+                                         "--spin-ratios", "0", "--height-ratios", "0", "--trials", "2",
+                                         "--height-trials", "2", "--rest-drops", "60", "--quiet"};
+  const auto run = [&](std::vector<std::string> extra, const std::string& stem) {
+    std::vector<std::string> args = base;
+    extra.insert(extra.end(), {"--out", dir.file(stem + ".hpp"), "--json", dir.file(stem + ".json")});
+    args.insert(args.end(), extra.begin(), extra.end());
+    std::string err;
+    REQUIRE_MESSAGE(gather_cli(args, &err) == 0, err);
+    return nlohmann::json::parse(read_file(dir.file(stem + ".json")));
+  };
+  const nlohmann::json all = run({}, "default");
+  const nlohmann::json cut = run({"--rest-min-frequency", "0.4", "--rest-max-dropped", "1"}, "cut");
+  // By default every pose is kept (each family is above the cut); the cut at 0.4 keeps the largest
+  // faces' family alone, the same drops (the same seed) otherwise.
+  CHECK(all["rest"].size() >= 4);
+  CHECK(all["rest_rare"].empty());
+  CHECK(all["rest_dropped"].get<double>() == 0.0);
+  REQUIRE(cut["rest"].size() == 2);
+  CHECK(cut["rest"].size() + cut["rest_rare"].size() == all["rest"].size());
+  CHECK(cut["rest"][0]["family"] == 0);
+  CHECK(cut["rest"][1]["family"] == 0);
+  CHECK(cut["rest"][0]["family_frequency"].get<double>() > 0.4);
+  CHECK(cut["rest_dropped"].get<double>() == doctest::Approx(1.0 - cut["rest"][0]["family_frequency"].get<double>()));
+  const std::string header = read_file(dir.file("cut.hpp"));
+  CHECK(header.find(" --rest-min-frequency 0.4 --rest-max-dropped 1 ") != std::string::npos);
+  CHECK(header.find("kept above 0.4, rare families kept while more than 1 is dropped") != std::string::npos);
+  CHECK(header.find("// Rest poses dropped: ") != std::string::npos);
+  // The defaults leave the option line as it was.
+  const std::string plain = read_file(dir.file("default.hpp"));
+  CHECK(plain.find("kept above 0.05\n") != std::string::npos);
+  CHECK(plain.find("--rest-min-frequency") == std::string::npos);
+  std::string err;
+  CHECK(gather_cli({"--shape", "box", "--rest-min-frequency", "1", "--out", dir.file("x.hpp"), "--quiet"}, &err) != 0);
+  CHECK(err.find("--rest-min-frequency must be in [0, 1)") != std::string::npos);
+  CHECK(gather_cli({"--shape", "box", "--rest-max-dropped", "-0.1", "--out", dir.file("x.hpp"), "--quiet"}, &err) != 0);
+  CHECK(err.find("--rest-max-dropped") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir.file("x.hpp")));
 }
 
 TEST_CASE("gather3d: the same command and seed give the same bytes with 1 or 2 threads")
@@ -380,7 +486,9 @@ TEST_CASE("gather3d: the committed lshape and bunny tables")
     float total = 0.0f;
     for (std::uint32_t i = 0; i < v.rest.count; ++i) {
       CHECK(v.rest.normal(i).norm() == doctest::Approx(1.0).epsilon(1e-5));
-      CHECK(v.rest.frequencies[i] > 0.05f);
+      // Rare poses are kept too (a family above the cut, or while the dropped share is large), but
+      // each was seen in at least 5 of the 1000 drops.
+      CHECK(v.rest.frequencies[i] >= 0.005f);
       CHECK(v.rest.heights[i] > 0.0f);
       CHECK(v.rest.heights[i] < v.bounding_radius);
       total += v.rest.frequencies[i];

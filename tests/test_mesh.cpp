@@ -263,6 +263,26 @@ TEST_CASE("the committed meshes")
   CHECK(ls.com.norm() < 1e-15);
   CHECK((ls.inertia - inertia).norm() < 1e-12 * inertia.norm());
 
+  // The nut: a hexagonal prism (area 3 sqrt(3)/2 R^2) less a 24-gon hole (area 12 r^2 sin 15 deg),
+  // 0.05 thick; symmetric about its centre; equal moments about the two axes across the hole.
+  TriMesh nut;
+  REQUIRE_MESSAGE(load_obj("tools/meshes/nut.obj", nut, e), e.message);
+  CHECK(nut.vertices.size() == 12 + 48);
+  const MassProperties nm = compute_mass_properties(nut);
+  const double hexagon = 1.5 * std::sqrt(3.0) * 0.06 * 0.06, hole = 12.0 * 0.03 * 0.03 * std::sin(3.14159265358979 / 12);
+  CHECK(nm.volume == doctest::Approx((hexagon - hole) * 0.05).epsilon(1e-9));
+  CHECK(nm.com.norm() < 1e-12);
+  CHECK(nm.principal_moments[0] == doctest::Approx(nm.principal_moments[1]).epsilon(1e-9));
+  CHECK(nm.principal_moments[2] > nm.principal_moments[1]);
+  bounding_box(nut, lo, hi);
+  CHECK((hi - lo).x() == doctest::Approx(0.12).epsilon(1e-12));
+  CHECK((hi - lo).y() == doctest::Approx(0.12 * std::sqrt(3.0) / 2).epsilon(1e-9));
+  CHECK((hi - lo).z() == doctest::Approx(0.05).epsilon(1e-12));
+  std::ostringstream out, err;
+  CHECK(mesh_nut(0.12, 0.05, 0.11, 24, "unused.obj", out, err) != 0);  // the hole would cut the flats
+  CHECK(mesh_nut(0.12, 0.05, 0.06, 18, "unused.obj", out, err) != 0);
+  CHECK_FALSE(fs::exists("unused.obj"));
+
   // 7 spheres: "x y z r" lines after the comments.
   std::istringstream spheres(read_file("tools/meshes/bunny_spheres7.txt"));
   std::string line;
@@ -449,6 +469,7 @@ TEST_CASE("mesh commands: outputs, determinism, and no output file on failure")
   const std::vector<std::pair<std::string, std::function<int(const std::string&)>>> derived = {
     {"tools/meshes/box.obj", [&](const std::string& o) { return mesh_box({0.2, 0.2, 0.2}, o, out, err); }},
     {"tools/meshes/lshape.obj", [&](const std::string& o) { return mesh_lshape(o, out, err); }},
+    {"tools/meshes/nut.obj", [&](const std::string& o) { return mesh_nut(0.12, 0.05, 0.06, 24, o, out, err); }},
     {"tools/meshes/bunny_low.obj",
      [&](const std::string& o) { return mesh_decimate("tools/meshes/bunny.obj", o, 100, out, err); }},
     {"tools/meshes/bunny_spheres7.txt",

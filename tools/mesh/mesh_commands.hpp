@@ -29,6 +29,11 @@ int mesh_box(const std::array<double, 3>& size, const std::string& out_file, std
 int mesh_wedge(double leg_x, double leg_y, double depth, const std::string& out_file, std::ostream& out,
                std::ostream& err);
 
+/// `mesh nut --across-corners A --thickness T --hole D --hole-segments N --out F.obj`: a hexagonal
+/// nut (shapes.hpp).
+int mesh_nut(double across_corners, double thickness, double hole_diameter, int hole_segments,
+             const std::string& out_file, std::ostream& out, std::ostream& err);
+
 /// `mesh lshape --out F.obj` (the fixed dimensions of shapes.hpp).
 int mesh_lshape(const std::string& out_file, std::ostream& out, std::ostream& err);
 

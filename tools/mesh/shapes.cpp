@@ -1,5 +1,6 @@
 #include "mesh/shapes.hpp"
 
+#include <cmath>
 #include <vector>
 
 namespace statsim::tools {
@@ -48,6 +49,48 @@ TriMesh make_wedge(double leg_x, double leg_y, double depth)
   // The centroid of a triangle is the mean of its corners: (leg_x / 3, leg_y / 3) from the right angle.
   const double cx = leg_x / 3.0, cy = leg_y / 3.0;
   return extrude({{-cx, -cy}, {leg_x - cx, -cy}, {-cx, leg_y - cy}}, 0, 0.5 * depth);
+}
+
+TriMesh make_nut(double across_corners, double thickness, double hole_diameter, int hole_segments)
+{
+  constexpr double kPi = 3.14159265358979323846;
+  const double outer = 0.5 * across_corners, inner = 0.5 * hole_diameter, h = 0.5 * thickness;
+  const int n = hole_segments, per_side = hole_segments / 6;
+  TriMesh m;
+  // Vertices: the hexagon at -h, at +h, then the hole's polygon at -h, at +h; corner k of the
+  // hexagon and vertex k * per_side of the hole at angle 60 k degrees.
+  for (double z : {-h, h})
+    for (int k = 0; k < 6; ++k) m.vertices.emplace_back(outer * std::cos(kPi * k / 3.0), outer * std::sin(kPi * k / 3.0), z);
+  for (double z : {-h, h})
+    for (int k = 0; k < n; ++k)
+      m.vertices.emplace_back(inner * std::cos(2.0 * kPi * k / n), inner * std::sin(2.0 * kPi * k / n), z);
+  const auto hex = [](int k, int top) { return top * 6 + k % 6; };
+  const auto hole = [n](int k, int top) { return 12 + top * n + k % n; };
+  // The caps' rings: hexagon side k (corners k, k + 1) faces the hole's vertices k * per_side ..
+  // (k + 1) * per_side; the first half are fanned from corner k, the second from corner k + 1,
+  // and one triangle joins both corners to the middle one. Every triangle then spans at most 30
+  // degrees about the axis, so none crosses the hole while it is narrower than the flats.
+  const int half = per_side / 2;
+  for (int k = 0; k < 6; ++k) {
+    const int mid = k * per_side + half;
+    for (int j = k * per_side; j < (k + 1) * per_side; ++j) {
+      const int corner = j < mid ? k : k + 1;
+      m.triangles.push_back({hex(corner, 1), hole(j + 1, 1), hole(j, 1)});  // top, normal +z
+      m.triangles.push_back({hex(corner, 0), hole(j, 0), hole(j + 1, 0)});  // bottom, normal -z
+    }
+    m.triangles.push_back({hex(k, 1), hex(k + 1, 1), hole(mid, 1)});
+    m.triangles.push_back({hex(k, 0), hole(mid, 0), hex(k + 1, 0)});
+  }
+  // The hexagon's sides, facing out; the hole's wall, facing the axis.
+  for (int k = 0; k < 6; ++k) {
+    m.triangles.push_back({hex(k, 0), hex(k + 1, 0), hex(k + 1, 1)});
+    m.triangles.push_back({hex(k, 0), hex(k + 1, 1), hex(k, 1)});
+  }
+  for (int k = 0; k < n; ++k) {
+    m.triangles.push_back({hole(k, 0), hole(k + 1, 1), hole(k + 1, 0)});
+    m.triangles.push_back({hole(k, 0), hole(k, 1), hole(k + 1, 1)});
+  }
+  return m;
 }
 
 TriMesh make_lshape()

@@ -5,11 +5,13 @@
 #include "common/atomic_file.hpp"
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
+#include "common/rest_families.hpp"
 #include "common/table_writer.hpp"
 #include "ref2d/box2d_util.hpp"
 #include "ref2d/compare2d.hpp"
 
 #include "statsim/response.hpp"
+#include "statsim/statistical.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -35,6 +37,11 @@ constexpr double kGravity = 9.81;
 constexpr std::uint64_t kHeightTable = 1;
 constexpr std::uint64_t kResponseTable = 2;
 constexpr std::uint64_t kRestPoses = 3;
+// Hull edges whose descriptors differ by no more than this (in units of the bounding radius) are
+// equivalent: far above the rounding of the body-frame hull, far below any visible difference.
+constexpr double kFamilyTolerance = 1e-3;
+// Fewest drops of a family kept by the dropped-share rule (fewer do not measure a frequency).
+constexpr int kRestMinCount = 5;
 // Box2D's skins: contact is reported (and resolved) once the cores are within 2 * 0.01 m.
 constexpr double kSkin = 2.0 * static_cast<double>(b2_polygonRadius);
 
@@ -307,7 +314,25 @@ void cluster_rest_poses(Gather2dResult& r)
     const Point2 a = hull[i], b = hull[(i + 1) % hull.size()];
     faces.push_back(normalized({-(b.y - a.y), b.x - a.x}));  // minus the outward normal
   }
+  // The invariants of resting on hull edge f under the shape's symmetries (common/rest_families.hpp),
+  // lengths in units of L: the rest height, the edge's length, how far the centroid's foot is
+  // from the edge's middle, and the sorted heights of every hull vertex above the ground.
+  const double L = r.shape.bounding_radius;
+  const auto descriptor = [&](std::size_t f) {
+    const Point2 up = faces[f], a = hull[f], b = hull[(f + 1) % hull.size()];
+    const double h = r.shape.support_height(up);
+    const Point2 along = {up.y, -up.x};
+    const double mid = 0.5 * ((a.x + b.x) * along.x + (a.y + b.y) * along.y);
+    std::vector<double> heights;
+    for (const Point2& v : hull) heights.push_back((v.x * up.x + v.y * up.y + h) / L);
+    std::sort(heights.begin(), heights.end());
+    std::vector<double> d = {h / L, std::hypot(b.x - a.x, b.y - a.y) / L, std::fabs(mid) / L,
+                             static_cast<double>(hull.size())};
+    d.insert(d.end(), heights.begin(), heights.end());
+    return d;
+  };
   r.clusters.clear();
+  std::vector<int> face_of;
   const double total = static_cast<double>(r.rest_ups.size());
   for (const Acc& a : acc) {
     RestCluster c;
@@ -321,27 +346,60 @@ void cluster_rest_poses(Gather2dResult& r)
     // Snap to the nearest hull face within 3 degrees: Box2D leaves a resting body tilted by its
     // solver tolerances only, and the exact face gives the exact rest height.
     double best = 3.0;
-    for (const Point2& f : faces) {
-      const double d = angle_between(mean, f);
+    int face = -1;
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      const double d = angle_between(mean, faces[f]);
       if (d <= best) {
         best = d;
-        c.normal = f;
+        c.normal = faces[f];
         c.snap_degrees = d;
+        face = static_cast<int>(f);
       }
     }
     c.height = r.shape.support_height(c.normal);
-    c.kept = c.frequency > o.min_frequency;
     r.clusters.push_back(c);
+    face_of.push_back(face);
   }
-  std::stable_sort(r.clusters.begin(), r.clusters.end(), [](const RestCluster& a, const RestCluster& b) {
-    if (a.kept != b.kept) {
-      return a.kept;
-    }
+  std::vector<std::size_t> order(r.clusters.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const auto by_count = [&](std::size_t i, std::size_t j) {
+    const RestCluster& a = r.clusters[i];
+    const RestCluster& b = r.clusters[j];
     if (a.count != b.count) {
       return a.count > b.count;
     }
     return std::atan2(a.normal.x, a.normal.y) < std::atan2(b.normal.x, b.normal.y);
-  });
+  };
+  std::stable_sort(order.begin(), order.end(), by_count);
+  std::vector<RestCandidate> candidates;
+  for (std::size_t i : order) {
+    RestCandidate k;
+    k.frequency = r.clusters[i].frequency;
+    k.count = r.clusters[i].count;
+    if (face_of[i] >= 0) {
+      k.descriptor = descriptor(static_cast<std::size_t>(face_of[i]));
+    }
+    candidates.push_back(k);
+  }
+  RestSelectionOptions so;
+  so.min_frequency = o.min_frequency;
+  so.max_dropped = o.max_dropped;
+  so.min_count = kRestMinCount;
+  so.max_poses = statsim::max_rest_poses;
+  so.tolerance = kFamilyTolerance;
+  const RestSelection sel = select_rest_poses(candidates, so);
+  std::vector<RestCluster> sorted;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    RestCluster c = r.clusters[order[k]];
+    c.kept = sel.kept[k] != 0;
+    c.family = sel.family[k];
+    c.family_frequency = sel.family_frequency[static_cast<std::size_t>(c.family)];
+    sorted.push_back(c);
+  }
+  // Kept ones first, each part still most frequent first.
+  std::stable_partition(sorted.begin(), sorted.end(), [](const RestCluster& c) { return c.kept; });
+  r.clusters = sorted;
+  r.rest_dropped = sel.dropped;
 }
 
 // fn(i) for every trial i < n on the options' worker threads, in order of i, with a progress
@@ -457,6 +515,12 @@ void validate_gather2d_options(const Gather2dOptions& o)
   }
   if (o.rest_drops < 20) {
     bad("--rest-drops must be at least 20");
+  }
+  if (!(o.min_frequency >= 0.0 && o.min_frequency < 1.0)) {
+    bad("--rest-min-frequency must be in [0, 1)");
+  }
+  if (!(o.max_dropped >= 0.0 && o.max_dropped <= 1.0)) {
+    bad("--rest-max-dropped must be in [0, 1]");
   }
   const auto increasing = [&](const std::vector<double>& a, const char* what, double lo, double hi) {
     if (a.empty()) {
@@ -649,14 +713,16 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
        " m/s^2, dt " + dt_text(o.rest_dt) + " s, until Box2D put the body to sleep; " +
        std::to_string(r.rest_time_limited) + " were still awake after " + g6(o.rest_time_limit) +
        " s;\n//   greedy clustering of body-frame up vectors at " + g6(o.cluster_degrees) +
-       " degrees, snapped to hull faces within 3 degrees; kept: frequency > " + g6(o.min_frequency) +
-       "; h_rest on the core shape\n";
+       " degrees, snapped to hull faces within 3 degrees; kept: families (poses equivalent under the shape's "
+       "symmetry) of frequency > " + g6(o.min_frequency) + ", then rarer ones while more than " + g6(o.max_dropped) +
+       " of the settled drops is dropped; h_rest on the core shape\n";
   for (std::size_t i = 0; i < r.clusters.size(); ++i) {
     const RestCluster& c = r.clusters[i];
     s += "//   " + std::string(c.kept ? "pose " + std::to_string(i) : "(not kept)") + ": up (" + fmt("%.6f", c.normal.x) +
          ", " + fmt("%.6f", c.normal.y) + ") h_rest " + fmt("%.6f", c.height) + " m, " + std::to_string(c.count) +
-         " drops, frequency " + fmt("%.4f", c.frequency) + "\n";
+         " drops, frequency " + fmt("%.4f", c.frequency) + ", family " + std::to_string(c.family) + "\n";
   }
+  s += "//   dropped: " + fmt("%.4f", r.rest_dropped) + " of the settled drops\n";
   s += table_prologue(o.name);
   s += "// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,\n"
        "//           spread values per cell (the paper's model: one standard deviation per component)>\n";
@@ -748,7 +814,10 @@ std::string gather2d_json(const Gather2dResult& r, const std::string& command)
                                   {"count", c.count},
                                   {"spread_degrees", c.spread_degrees},
                                   {"snap_degrees", c.snap_degrees},
-                                  {"kept", c.kept}});
+                                  {"kept", c.kept},
+                                  {"family", c.family},
+                                  {"family_frequency", c.family_frequency}});
+  j["rest_dropped"] = r.rest_dropped;
   return j.dump(2) + "\n";
 }
 
@@ -784,8 +853,9 @@ std::string gather2d_summary(const Gather2dResult& r)
          fmt("%.3f", c.frequency) + "  (" + std::to_string(c.count) + " drops, spread " +
          fmt("%.2f", c.spread_degrees) + " deg" +
          (c.snap_degrees >= 0 ? ", snapped " + fmt("%.3f", c.snap_degrees) + " deg" : std::string(", not snapped")) +
-         ")\n";
+         ", family " + std::to_string(c.family) + ")\n";
   }
+  s += "    dropped: " + fmt("%.3f", r.rest_dropped) + " of the settled drops\n";
   return s;
 }
 
@@ -887,6 +957,16 @@ void register_gather2d_commands(CLI::App& app)
   CLI::Option* friction = g->add_option("--friction", o.friction, "Friction of body and ground")
                               ->capture_default_str()
                               ->check(CLI::Range(0.0, 10.0));
+  CLI::Option* min_frequency =
+      g->add_option("--rest-min-frequency", o.min_frequency,
+                    "Rest poses: keep every pose of a family (poses equivalent under the shape's symmetry) seen in "
+                    "more than this fraction of the drops together, in [0, 1)")
+          ->capture_default_str();
+  CLI::Option* max_dropped =
+      g->add_option("--rest-max-dropped", o.max_dropped,
+                    "Rest poses: then keep rarer families, most frequent first, while more than this fraction of the "
+                    "settled drops is in poses not kept, in [0, 1] (1: never)")
+          ->capture_default_str();
   g->add_option("--threads", o.threads, "Worker threads (0 = all); the output does not depend on it")
       ->capture_default_str();
   g->add_option("--json", cmd->json, "Also write a JSON summary (statistics, counts, timings) to this file");
@@ -899,7 +979,9 @@ void register_gather2d_commands(CLI::App& app)
                    {"--height-trials", height_trials},
                    {"--rest-drops", rest},
                    {"--restitution", restitution},
-                   {"--friction", friction}};
+                   {"--friction", friction},
+                   {"--rest-min-frequency", min_frequency},
+                   {"--rest-max-dropped", max_dropped}};
   g->callback([cmd]() { run_gather2d_command(*cmd); });
 
   register_compare2d_command(app);

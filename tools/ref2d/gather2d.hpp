@@ -10,7 +10,10 @@
 //     theta to the inverse normal and signed spin; Box2D resolves the collision until the body
 //     separates; W+ L / |V-| and (V_rigid+ - V_particle+) / |V-| are averaged per cell;
 //  3. rest poses (paper 3.2.3): drops with gravity until Box2D puts the body to sleep; the
-//     body-frame up vectors are clustered; poses seen in more than 5% of the drops are kept.
+//     body-frame up vectors are clustered and snapped to hull edges; poses equivalent under the
+//     shape's symmetry form families, and the poses kept are those of the families seen in more
+//     than 5% of the drops together, then rarer families while more than 2% of the settled drops
+//     would be in poses not kept (common/rest_families.hpp, the rule of statsim gather).
 #pragma once
 
 #include "ref2d/fig3.hpp"
@@ -55,7 +58,8 @@ struct Gather2dOptions {
   double rest_dt = 1.0 / 120.0;
   double rest_time_limit = 30.0;      ///< s of simulated time per drop
   double cluster_degrees = 10.0;      ///< greedy clustering tolerance
-  double min_frequency = 0.05;        ///< poses kept: frequency > this
+  double min_frequency = 0.05;        ///< families kept: summed frequency > this
+  double max_dropped = 0.02;          ///< then rarer families kept while the dropped share exceeds this
 
   unsigned threads = 0;  ///< 0 = hardware concurrency; does not change the result
   bool progress = false;
@@ -83,6 +87,8 @@ struct RestCluster {
   double spread_degrees = 0.0;  ///< largest angle of a member to the (unsnapped) mean
   double snap_degrees = -1.0;   ///< angle moved when snapped to a hull face normal; < 0: not snapped
   bool kept = false;
+  int family = 0;  ///< equivalence family under the shape's symmetry, 0 = most frequent
+  double family_frequency = 0.0;  ///< the family's summed frequency
 };
 
 struct Gather2dResult {
@@ -99,6 +105,7 @@ struct Gather2dResult {
   int rest_drops = 0;
   int rest_time_limited = 0;
   std::vector<RestCluster> clusters;  ///< all clusters, kept ones first (by frequency)
+  double rest_dropped = 0.0;          ///< fraction of the settled drops in poses not kept
   std::vector<Point2> rest_ups;       ///< final body-frame up vector of each drop
   std::vector<char> rest_settled;     ///< per drop: 1 = Box2D put it to sleep
   double seconds_heights = 0.0;

@@ -3,10 +3,12 @@
 #include "common/format.hpp"
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
+#include "common/rest_families.hpp"
 #include "common/table_writer.hpp"
 #include "ref3d/sampling.hpp"
 #include "statsim/response.hpp"
 #include "statsim/signature.hpp"
+#include "statsim/statistical.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -33,6 +35,13 @@ constexpr std::uint64_t kRestStream = 3;
 constexpr std::uint64_t kCheckStream = 5;
 // Rest normals within this angle of a hull face's are snapped to it.
 constexpr double kSnapDegrees = 3.0;
+// Hull faces whose descriptors differ by no more than this (in units of the bounding radius) are
+// equivalent: far above the rounding of a mesh read from decimal text and of the transform to
+// the body frame (1e-9 and below), far below any difference one could see (0.1 mm on a 0.1 m body).
+constexpr double kFamilyTolerance = 1e-3;
+// Fewest drops of a family kept by the dropped-share rule: with fewer, a frequency is not measured
+// (its relative standard error is above 1/sqrt(5), about 45 %).
+constexpr int kRestMinCount = 5;
 
 // A pool of Reference objects, one per worker at most: a task borrows one and gives it back.
 // Trials build a fresh Bullet world each, so which object runs a trial does not matter.
@@ -172,6 +181,7 @@ void validate_gather_options(const GatherOptions& o)
       (o.empirical_outcomes < 1 || o.empirical_outcomes > o.trials ||
        o.empirical_outcomes > static_cast<int>(max_empirical_outcomes)))
     fail("--empirical-outcomes must be in [1, min(--trials, " + std::to_string(max_empirical_outcomes) + ")]");
+  if (!(o.rest_max_dropped >= 0 && o.rest_max_dropped <= 1)) fail("--rest-max-dropped must be in [0, 1]");
   if (!(o.max_impact_time > 0) || !(o.max_drop_time > 0) || !(o.still_time > 0) || !(o.still_speed > 0))
     fail("time limits and the stillness threshold must be positive");
   auto axis = [&](const std::vector<double>& v, const char* what, double lo, double hi) {
@@ -333,6 +343,52 @@ std::vector<int> cluster_directions(const std::vector<Eigen::Vector3d>& dirs, do
   return label;
 }
 
+// The invariants of standing on hull face `plane` under the shape's symmetries (a symmetry fixes
+// the centre of mass and maps the face onto an equivalent one), lengths in units of the bounding
+// radius L: the rest height; the moment of inertia about the up axis per unit mass; the face's
+// area; its vertex count and sorted edge lengths; the sorted distances of its vertices from the
+// centre's projection on it; and the sorted heights of every hull vertex above the ground.
+std::vector<double> face_descriptor(const ShapeModel& m, const Eigen::Vector4d& plane)
+{
+  const double L = m.bounding_radius;
+  const Eigen::Vector3d n = plane.head<3>();
+  const double w = plane.w();
+  const Eigen::Vector3d foot = w * n;
+  const Eigen::Vector3d a = n.unitOrthogonal(), b = n.cross(a);
+  std::vector<Eigen::Vector2d> face;
+  std::vector<double> heights;
+  for (const Eigen::Vector3d& p : m.hull) {
+    const double d = w - n.dot(p);
+    heights.push_back(d / L);
+    if (d <= 1e-6 * L) face.emplace_back(a.dot(p - foot) / L, b.dot(p - foot) / L);
+  }
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& q : face) centre += q;
+  if (!face.empty()) centre /= static_cast<double>(face.size());
+  std::sort(face.begin(), face.end(), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
+    return std::atan2(p.y() - centre.y(), p.x() - centre.x()) < std::atan2(q.y() - centre.y(), q.x() - centre.x());
+  });
+  double area = 0.0;
+  std::vector<double> edges, radii;
+  for (std::size_t i = 0; i < face.size(); ++i) {
+    const Eigen::Vector2d& p = face[i];
+    const Eigen::Vector2d& q = face[(i + 1) % face.size()];
+    area += 0.5 * (p.x() * q.y() - q.x() * p.y());
+    edges.push_back((q - p).norm());
+    radii.push_back(p.norm());
+  }
+  std::sort(edges.begin(), edges.end());
+  std::sort(radii.begin(), radii.end());
+  std::sort(heights.begin(), heights.end());
+  const Eigen::Vector3d& I = m.unit_inertia;
+  std::vector<double> d = {w / L, (n.x() * n.x() * I.x() + n.y() * n.y() * I.y() + n.z() * n.z() * I.z()) / (L * L),
+                           std::fabs(area), static_cast<double>(face.size()), static_cast<double>(heights.size())};
+  d.insert(d.end(), edges.begin(), edges.end());
+  d.insert(d.end(), radii.begin(), radii.end());
+  d.insert(d.end(), heights.begin(), heights.end());
+  return d;
+}
+
 }  // namespace
 
 // ---- gathering -------------------------------------------------------------------------------
@@ -469,50 +525,92 @@ GatherResult gather(const GatherOptions& options)
     const std::vector<int> label = cluster_directions(ups, o.rest_tolerance_deg * kPi / 180.0);
     int clusters = 0;
     for (int l : label) clusters = std::max(clusters, l + 1);
-    std::vector<RestPose> poses;
-    for (int c = 0; c < clusters; ++c) {
+    // Each cluster's members, merged when two clusters snap to the same hull face (the same pose).
+    struct Group {
       std::vector<std::size_t> members;
+      Eigen::Vector3d normal;
+      int face = -1;  // index into m.hull_planes when snapped
+    };
+    std::vector<Group> groups;
+    const double cos_snap = std::cos(kSnapDegrees * kPi / 180.0);
+    for (int c = 0; c < clusters; ++c) {
+      Group g;
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       for (std::size_t i = 0; i < label.size(); ++i)
         if (label[i] == c) {
-          members.push_back(i);
+          g.members.push_back(i);
           sum += ups[i];
         }
-      if (members.empty()) continue;
-      RestPose p;
-      p.normal = sum.normalized();
-      // A body at rest stands on a face of its convex hull: snap to that face's normal.
+      if (g.members.empty()) continue;
+      g.normal = sum.normalized();
+      // A body at rest stands on a face of its convex hull: the face whose inward normal is nearest.
       double best = -2.0;
-      Eigen::Vector3d face = p.normal;
-      for (const Eigen::Vector4d& plane : m.hull_planes) {
-        const double along = -plane.head<3>().dot(p.normal);
+      for (std::size_t f = 0; f < m.hull_planes.size(); ++f) {
+        const double along = -m.hull_planes[f].head<3>().dot(g.normal);
         if (along > best) {
           best = along;
-          face = -plane.head<3>();
+          g.face = static_cast<int>(f);
         }
       }
-      if (best >= std::cos(kSnapDegrees * kPi / 180.0)) {
-        p.normal = face + Eigen::Vector3d::Zero();  // + 0: no negative zeros
+      if (!(best >= cos_snap)) g.face = -1;
+      auto same = std::find_if(groups.begin(), groups.end(), [&](const Group& h) { return g.face >= 0 && h.face == g.face; });
+      if (same != groups.end()) same->members.insert(same->members.end(), g.members.begin(), g.members.end());
+      else groups.push_back(g);
+    }
+    std::vector<RestPose> poses;
+    std::vector<int> pose_face;
+    for (const Group& g : groups) {
+      RestPose p;
+      p.normal = g.normal;
+      const Stats s = stats(g.members.size(), [&](std::size_t k) { return heights[g.members[k]]; });
+      p.height = s.mean;
+      if (g.face >= 0) {
+        const Eigen::Vector4d& plane = m.hull_planes[static_cast<std::size_t>(g.face)];
+        p.normal = -plane.head<3>() + Eigen::Vector3d::Zero();  // + 0: no negative zeros
         p.snapped = true;
         // Standing on that face, the centre is exactly the face's offset above the ground.
-        for (const Eigen::Vector4d& plane : m.hull_planes)
-          if (-plane.head<3>() == face) p.height = plane.w();
+        p.height = plane.w();
       }
-      const Stats s = stats(members.size(), [&](std::size_t k) { return heights[members[k]]; });
-      p.height = s.mean;
       p.measured_height = s.mean;
       p.height_std = s.std;
-      p.count = static_cast<int>(members.size());
+      p.count = static_cast<int>(g.members.size());
       p.frequency = static_cast<double>(p.count) / static_cast<double>(std::max(1, r.settled));
       poses.push_back(p);
+      pose_face.push_back(g.face);
     }
-    std::stable_sort(poses.begin(), poses.end(), [](const RestPose& a, const RestPose& b) {
+    std::vector<std::size_t> order(poses.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+      const RestPose& a = poses[i];
+      const RestPose& b = poses[j];
       if (a.count != b.count) return a.count > b.count;
       for (int k = 0; k < 3; ++k)
         if (a.normal[k] != b.normal[k]) return a.normal[k] < b.normal[k];
       return false;
     });
-    for (const RestPose& p : poses) (p.frequency > o.rest_min_frequency ? r.rest : r.rest_rare).push_back(p);
+    std::vector<RestCandidate> candidates;
+    for (std::size_t i : order) {
+      RestCandidate c;
+      c.frequency = poses[i].frequency;
+      c.count = poses[i].count;
+      if (pose_face[i] >= 0) c.descriptor = face_descriptor(m, m.hull_planes[static_cast<std::size_t>(pose_face[i])]);
+      candidates.push_back(c);
+    }
+    RestSelectionOptions so;
+    so.min_frequency = o.rest_min_frequency;
+    so.max_dropped = o.rest_max_dropped;
+    so.min_count = kRestMinCount;
+    so.max_poses = statsim::max_rest_poses;
+    so.tolerance = kFamilyTolerance;
+    const RestSelection sel = select_rest_poses(candidates, so);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      RestPose p = poses[order[k]];
+      p.family = sel.family[k];
+      p.family_frequency = sel.family_frequency[static_cast<std::size_t>(p.family)];
+      (sel.kept[k] ? r.rest : r.rest_rare).push_back(p);
+    }
+    r.rest_dropped = sel.dropped;
+    r.rest_families = static_cast<int>(sel.family_frequency.size());
     r.rest_seconds = seconds_since(t0);
   }
   return r;
@@ -690,7 +788,10 @@ std::vector<std::string> option_lines(const GatherResult& r)
               num(o.max_impact_time) + " s; rest: " + std::to_string(o.rest_drops) + " drops, still below " +
               num(o.still_speed) + " m/s for " + num(o.still_time) + " s (limit " + num(o.max_drop_time) +
               " s), clusters within " + num(o.rest_tolerance_deg) + " deg, kept above " +
-              num(o.rest_min_frequency));
+              num(o.rest_min_frequency) +
+              (o.rest_max_dropped == GatherOptions().rest_max_dropped
+                   ? std::string()
+                   : ", rare families kept while more than " + num(o.rest_max_dropped) + " is dropped"));
   return l;
 }
 
@@ -716,9 +817,13 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << "// Trials: " << flights << " flights, "
     << r.response_trials << " impacts (" << r.time_limited << " hit the time limit), " << o.rest_drops
     << " rest drops (" << r.unsettled << " did not settle)\n";
-  h << "// Rest poses (body-frame up, height, frequency):";
-  for (const RestPose& p : r.rest) h << " " << vec3(p.normal, "%.4f") << " " << fmt("%.5f", p.height) << " m " << fmt("%.3f", p.frequency) << ";";
+  h << "// Rest poses (body-frame up, height, frequency, family):";
+  for (const RestPose& p : r.rest)
+    h << " " << vec3(p.normal, "%.4f") << " " << fmt("%.5f", p.height) << " m " << fmt("%.3f", p.frequency)
+      << " family " << p.family << ";";
   h << "\n";
+  h << "// Rest poses dropped: " << fmt("%.3f", r.rest_dropped) << " of the settled drops (" << r.rest_rare.size()
+    << " poses; families of poses equivalent under the shape's symmetry kept together)\n";
   const std::vector<double> spread = response_spread(r);
   const std::size_t spread_size = spread.size() / std::max<std::size_t>(1, r.response_mean.size() / 6);
   Quantized qm, qs;
@@ -868,15 +973,23 @@ std::string json_text(const GatherResult& r, const std::string& command)
                     {"measured_height", p.measured_height},
                     {"height_std", p.height_std},
                     {"snapped", p.snapped},
-                    {"count", p.count}});
+                    {"count", p.count},
+                    {"family", p.family},
+                    {"family_frequency", p.family_frequency}});
   j["rest"] = rest;
   json rare = json::array();
   for (const RestPose& p : r.rest_rare)
     rare.push_back({{"normal", {p.normal.x(), p.normal.y(), p.normal.z()}},
                     {"height", p.height},
                     {"frequency", p.frequency},
-                    {"count", p.count}});
+                    {"count", p.count},
+                    {"family", p.family},
+                    {"family_frequency", p.family_frequency}});
   j["rest_rare"] = rare;
+  j["rest_dropped"] = r.rest_dropped;
+  j["rest_families"] = r.rest_families;
+  j["rest_min_frequency"] = o.rest_min_frequency;
+  j["rest_max_dropped"] = o.rest_max_dropped;
   j["rest_drops"] = o.rest_drops;
   j["settled"] = r.settled;
   j["unsettled"] = r.unsettled;
@@ -895,13 +1008,15 @@ std::string summary_text(const GatherResult& r)
   s << "responses: " << r.response_trials << " impacts, " << r.time_limited << " time-limited, deepest penetration "
     << fmt("%.3g", r.max_penetration) << " m (" << fmt("%.1f", r.response_seconds) << " s)\n";
   s << "rest: " << r.settled << " settled (mean " << fmt("%.2f", r.mean_settle_time) << " s), " << r.unsettled << " unsettled; " << r.rest.size() << " poses kept, "
-    << r.rest_rare.size() << " rare (" << fmt("%.1f", r.rest_seconds) << " s)\n";
+    << r.rest_rare.size() << " dropped (" << fmt("%.3f", r.rest_dropped) << " of the settled drops); "
+    << r.rest_families << " families (" << fmt("%.1f", r.rest_seconds) << " s)\n";
   for (const RestPose& p : r.rest)
-    s << "  up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m (std " << fmt("%.2g", p.height_std)
-      << ")  frequency " << fmt("%.3f", p.frequency) << "\n";
+    s << "  up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m (measured "
+      << fmt("%.5f", p.measured_height) << ", std " << fmt("%.2g", p.height_std) << ")  frequency "
+      << fmt("%.3f", p.frequency) << "  family " << p.family << " (" << fmt("%.3f", p.family_frequency) << ")\n";
   for (const RestPose& p : r.rest_rare)
-    s << "  (rare) up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m  frequency "
-      << fmt("%.3f", p.frequency) << "\n";
+    s << "  (dropped) up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m  frequency "
+      << fmt("%.3f", p.frequency) << "  family " << p.family << " (" << fmt("%.3f", p.family_frequency) << ")\n";
   if (r.options.i16) {
     const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
     s << "i16: worst dequantization error " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << "\n";

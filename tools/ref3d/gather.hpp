@@ -17,11 +17,22 @@
 //    statsim::point_particle_velocity. At s = 0 phi does not matter, and the cells of all phi
 //    share the statistics of all their trials.
 // 3. Rest poses: `rest_drops` drops with gravity from random poses and velocities until the body
-//    is still; body-frame up vectors clustered within `rest_tolerance_deg`; clusters with more
-//    than `rest_min_frequency` of the settled drops are kept, with their mean centre height on
-//    the true geometry and their frequency. A body at rest stands on a face of its convex hull, so
-//    a cluster's mean normal within 3 degrees of a hull face's is replaced by the face's, and its
-//    height by the face's distance from the centre of mass (the measured mean is in the JSON).
+//    is still; body-frame up vectors clustered within `rest_tolerance_deg`. A body at rest stands
+//    on a face of its convex hull, so a cluster's mean normal within 3 degrees of a hull face's
+//    is replaced by the face's, and its height by the face's distance from the centre of mass:
+//    the exact rest height of the true geometry standing on that face, which the runtime's
+//    snapped orientation needs (the measured mean, in the JSON, is of bodies tilted by up to
+//    the clustering angle). Clusters snapped to the same face are one pose. Which poses are kept
+//    (common/rest_families.hpp): poses are grouped into families equivalent under the shape's
+//    symmetry (hull faces with the same rest height, face area, face shape, centre projection,
+//    moment of inertia about the up axis and hull vertex heights, within 1e-3 of the bounding
+//    radius); every member of a family seen in more than `rest_min_frequency` of the settled
+//    drops together is kept; then, while more than `rest_max_dropped` of the settled drops are
+//    in poses not kept, the most frequent remaining family seen in at least 5 drops is kept too.
+//    A hexagonal nut's six side faces, each rarer than the cut, are thus one family above it; a
+//    shape's few rare poses of different kinds are kept while together they would be a visible
+//    part of its rest-pose distribution (tools/ref3d/README.md has the measurements). The header
+//    and the JSON give each pose's family and the dropped share.
 #pragma once
 
 #include "ref3d/model.hpp"
@@ -68,7 +79,9 @@ struct GatherOptions {
   double still_time = 0.25;          ///< s: a drop has settled after two still windows of this length
   double max_drop_time = 60.0;       ///< s before a drop counts as unsettled
   double rest_tolerance_deg = 10.0;
-  double rest_min_frequency = 0.05;
+  double rest_min_frequency = 0.05;  ///< families above this summed frequency are kept
+  /// Rare families are kept too while more than this share of the settled drops is in poses not kept.
+  double rest_max_dropped = 0.02;
   std::vector<double> height_ratios = default_height_ratios();
   std::vector<double> cos_theta = default_cos_theta();
   std::vector<double> cos_phi = default_cos_phi();
@@ -91,6 +104,8 @@ struct RestPose {
   double frequency = 0.0;   ///< fraction of the settled drops
   int count = 0;
   bool snapped = false;     ///< the normal is a hull face's (the mean was within 3 degrees of it)
+  int family = 0;           ///< equivalence family under the shape's symmetry, 0 = most frequent
+  double family_frequency = 0.0;  ///< the family's summed frequency
 };
 
 /// One impact's normalised outcome: W+ L/|V-| (3), (V+ - V_particle+)/|V-| (3).
@@ -114,7 +129,9 @@ struct GatherResult {
   double max_penetration = 0.0;
   // rest poses
   std::vector<RestPose> rest;  ///< kept poses, most frequent first
-  std::vector<RestPose> rest_rare;  ///< clusters at or below the frequency cut
+  std::vector<RestPose> rest_rare;  ///< poses not kept
+  double rest_dropped = 0.0;  ///< fraction of the settled drops in poses not kept
+  int rest_families = 0;      ///< families of all poses, kept or not
   int settled = 0, unsettled = 0;
   double mean_settle_time = 0.0;  ///< s of simulation, over the settled drops
   /// Extra header lines ("// Sized: ..."; "sizing" in the JSON), e.g. how --size-for-scene

@@ -236,6 +236,14 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   sub->add_option("--trials", o.trials, "Impacts per response cell (>= 2)")->capture_default_str();
   sub->add_option("--height-trials", o.height_trials, "Flights per h_coll sample (>= 2)")->capture_default_str();
   sub->add_option("--rest-drops", o.rest_drops, "Drops for the rest poses")->capture_default_str();
+  sub->add_option("--rest-min-frequency", o.rest_min_frequency,
+                  "Rest poses: keep every pose of a family (poses equivalent under the shape's symmetry) seen in more "
+                  "than this fraction of the settled drops together, in [0, 1)")
+      ->capture_default_str();
+  sub->add_option("--rest-max-dropped", o.rest_max_dropped,
+                  "Rest poses: then keep rarer families, most frequent first, while more than this fraction of the "
+                  "settled drops is in poses not kept, in [0, 1] (1: never)")
+      ->capture_default_str();
   sub->add_option("--seed", o.seed, "Random seed (same seed, same bytes, any --threads)")->capture_default_str();
   sub->add_option("--precision", c->precision, "Response tables as f32 or as i16 with per-table scale and offset")
       ->check(CLI::IsMember({"f32", "i16"}))
