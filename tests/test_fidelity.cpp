@@ -451,6 +451,16 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
   for (const char* k : keys) CHECK(j.at("noise_floor").contains(k));
   CHECK(j.at("methods").at("statistical").at("table_bytes").get<long long>() > 0);
   CHECK(j.at("methods").at("sphere").at("table_bytes").is_null());
+  // The energy guard's clamp rate: statsim's responses counted, none for Bullet.
+  const nlohmann::json& stat = j.at("methods").at("statistical");
+  CHECK(stat.at("sample").at("statistical_responses").get<long long>() >= 8);  // one or more per drop
+  CHECK(stat.at("clamp_rate").get<double>() ==
+        doctest::Approx(stat.at("sample").at("energy_clamps").get<double>() /
+                        stat.at("sample").at("statistical_responses").get<double>()));
+  CHECK(j.at("methods").at("sphere").at("clamp_rate").is_null());
+  CHECK(j.at("methods").at("sphere").at("sample").at("statistical_responses").get<long long>() == 0);
+  for (const char* k : {"no_flight", "not_rested_share", "mean_flight_speed", "mean_flight_spin"})
+    CHECK(j.at("reference").contains(k));
   // The same drops as the reference: every distance is 0, except rest_height_err (and with it
   // summary_error), which measures heights against the reference's mean height per configuration
   // and so keeps the reference's own spread about that mean.
