@@ -39,8 +39,7 @@
 //    reference's mean over its drops that rested; the share that did not rest is reported for
 //    each sample beside it. A rigid body rocking on a curved side loses energy only at impacts
 //    and can rock past any time limit; its time to rest is unknown, and the time limit in its
-//    place would measure the limit. When only one
-//    sample has drops that rested: 1.
+//    place would measure the limit. When only one sample has drops that rested: 1.
 //  - first_impact_ks: the tables describe a collision as everything from the first contact until
 //    the body has left the ground for good (a box landing on a corner strikes with a second and a
 //    third), and give the velocity and spin it leaves with. Each drop is measured at that event,
@@ -240,7 +239,7 @@ double guard(double m)
   return m > 0 ? m : 1.0;
 }
 
-// Stands for "no flight" in the samples of speeds and spins at the top (both are >= 0).
+// Stands for "no flight" in the samples of leaving speeds and spins (both are >= 0).
 constexpr double kNoFlight = -1.0;
 
 // W1 of the times to rest of the drops that rest in each sample, over the reference's mean: a

@@ -354,8 +354,8 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--methods", *method_list,
                   "comma-separated: full, full-gather (Bullet full with the gathering's settings at --dt: the "
                   "reference's engine at the methods' step), low, hull, spheres7, sphere, statistical, "
-                  "statistical-norest, statistical-independent, statistical:NAME (default: full,low,spheres7,sphere,statistical,"
-                  "statistical-norest,statistical-independent)");
+                  "statistical-norest, statistical-independent, statistical:NAME (default: "
+                  "full,low,spheres7,sphere,statistical,statistical-norest,statistical-independent)");
   cmd->add_option("--runs", opts->runs, "single drops per sample")->capture_default_str();
   cmd->add_option("--dt", *dt_text, "step of the methods, s (a number or 1/N)")->capture_default_str();
   cmd->add_option("--reference-dt", *reference_dt_text, "step of the reference in single drops, s (a number or 1/N)")
