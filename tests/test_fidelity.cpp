@@ -11,9 +11,11 @@
 #include "tables/box.hpp"
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Core>
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -53,6 +55,58 @@ int run_cli(const std::vector<std::string>& args)
     return app.exit(e);
   }
   return 0;
+}
+
+
+// Velocity and spin after each step (the first entry: the initial state) of a body dropped at
+// rest and struck by the ground at the given times, as an engine records them: each step adds
+// gravity, then a strike within the step replaces the velocity and spin with the strike's (the
+// contacts are solved after gravity). Between strikes the flight is free.
+struct Strike {
+  double t;  // s
+  Eigen::Vector3d v, w;
+};
+using Trajectory = std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>;
+Trajectory strikes_trajectory(double dt, double duration, const Eigen::Vector3d& spin0,
+                              const std::vector<Strike>& strikes)
+{
+  Trajectory out{{Eigen::Vector3d::Zero(), spin0}};
+  Eigen::Vector3d v = Eigen::Vector3d::Zero(), w = spin0;
+  const long steps = std::lround(duration / dt);
+  for (long k = 1; k <= steps; ++k) {
+    const double t0 = static_cast<double>(k - 1) * dt, t1 = static_cast<double>(k) * dt;
+    v.z() -= 9.81 * dt;
+    for (const Strike& s : strikes)
+      if (s.t > t0 && s.t <= t1) v = s.v, w = s.w;
+    out.emplace_back(v, w);
+  }
+  return out;
+}
+
+FlightTop track(const Trajectory& trajectory, double dt, double min_rise)
+{
+  FlightTop top(dt, min_rise);
+  for (const auto& [v, w] : trajectory) top.add(v, w);
+  return top;
+}
+
+// The rule statsim fidelity measured the first impact with before: the state after the first
+// step whose vertical velocity rises by more than 2 g dt (steps of 1/60 s and more), or after
+// the first later step without such a rise (smaller steps). Returns |v|, |w|.
+std::pair<double, double> old_first_impact(const Trajectory& trajectory, double dt)
+{
+  const double rise = 2 * 9.81 * dt;
+  bool pending = false;
+  for (std::size_t k = 1; k < trajectory.size(); ++k) {
+    const bool kick = trajectory[k].first.z() - trajectory[k - 1].first.z() > rise;
+    if (!pending && kick) {
+      if (dt >= 1.0 / 60.0 - 1e-12) return {trajectory[k].first.norm(), trajectory[k].second.norm()};
+      pending = true;
+    } else if (pending && !kick) {
+      return {trajectory[k].first.norm(), trajectory[k].second.norm()};
+    }
+  }
+  return {-1, -1};
 }
 
 // The loaded signature's numbers in the generated header's order.
@@ -159,8 +213,9 @@ TEST_CASE("fidelity: compare gives zero for a sample against itself and more for
     r.bounces = i % 4;
     r.rest_time = 1.0 + 0.05 * i;
     r.impact = true;
-    r.impact_speed = 0.5 + 0.02 * i;
-    r.impact_spin = 3.0 + 0.1 * i;
+    r.flight = true;
+    r.flight_speed = 0.5 + 0.02 * i;
+    r.flight_spin = 3.0 + 0.1 * i;
     ref.push_back(r);
   }
   const Distances same = compare(ref, ref, {}, {}, 4, 20);
@@ -178,7 +233,7 @@ TEST_CASE("fidelity: compare gives zero for a sample against itself and more for
     r.rest_height += 0.05;
     r.travel += 0.2;
     r.bounces += 1;
-    r.impact_speed += 10;
+    r.flight_speed += 10;
   }
   const Distances d = compare(moved, ref, {}, {}, 4, 20);
   CHECK(d.rest_tvd.value == doctest::Approx(1.0));
@@ -197,6 +252,106 @@ TEST_CASE("fidelity: compare gives zero for a sample against itself and more for
   CHECK(piles.pile_radial_w1.value == 0.0);
   CHECK(piles.pile_height_w1.value == 0.0);
   CHECK(piles.pile_rest_tvd.value == 0.0);
+}
+
+TEST_CASE("fidelity: a collision of several strikes gives the same leaving state at every step")
+{
+  // Falling from rest, the body strikes the ground at 0.40 s (a corner: it hops 0.02 m/s up,
+  // 0.02 mm of rise, spinning fast), strikes again 8 ms later with the next corner and leaves at
+  // 1.2 m/s up: the collision is both strikes. Its flight is free until it lands at 0.80 s (a
+  // second collision, not part of the first).
+  const Eigen::Vector3d v1(0.3, 0.1, 0.02), w1(0.5, 9.0, -1.0);
+  const Eigen::Vector3d v2(0.6, -0.2, 1.2), w2(-2.0, 3.0, 0.5);
+  const std::vector<Strike> strikes{{0.4005, v1, w1}, {0.4085, v2, w2}, {0.8005, {0.1, 0, 0.3}, {0, 0, 0}}};
+  const Eigen::Vector3d spin0(1.0, -2.0, 0.5);
+  const double min_rise = 0.01;
+  std::vector<std::pair<double, double>> old;
+  for (const double dt : {0.001, 1.0 / 240.0, 1.0 / 60.0}) {
+    CAPTURE(dt);
+    const Trajectory tr = strikes_trajectory(dt, 1.2, spin0, strikes);
+    const FlightTop top = track(tr, dt, min_rise);
+    CHECK(top.contact());
+    REQUIRE(top.found());
+    CHECK(top.speed() == v2.norm());
+    CHECK(top.spin() == w2.norm());
+    CHECK(top.rise() == doctest::Approx(1.2 * 1.2 / (2 * 9.81)));
+    old.push_back(old_first_impact(tr, dt));
+  }
+  // What was measured before: the state after the first strike at 1 ms (less a step of
+  // gravity), both strikes at 1/60 s (one step).
+  CHECK(old[0].first == doctest::Approx((v1 - Eigen::Vector3d(0, 0, 9.81e-3)).norm()));
+  CHECK(old[2].first == doctest::Approx(v2.norm()));
+  CHECK(std::fabs(old[0].second - old[2].second) > 5.0);
+  // A flight lower than min_rise does not end the collision: with a lower threshold the first
+  // strike's hop (at 1 ms, where the hop has free steps up to its top) ends it.
+  const Trajectory fine = strikes_trajectory(0.001, 1.2, spin0, strikes);
+  const FlightTop low = track(fine, 0.001, 1e-5);
+  REQUIRE(low.found());
+  CHECK(low.speed() == v1.norm());
+}
+
+TEST_CASE("fidelity: a drop that never flies again after its first contact has no flight")
+{
+  // The body lands at 0.30 s with a 1 mm hop, then slides on the ground, friction taking
+  // 0.5 g of its speed, and rests: no step of its slide or rest is free.
+  for (const double dt : {0.001, 1.0 / 60.0}) {
+    CAPTURE(dt);
+    Trajectory tr = strikes_trajectory(dt, 0.3, Eigen::Vector3d(0, 3, 0), {});
+    const Trajectory hop =
+        strikes_trajectory(dt, 0.02, Eigen::Vector3d(0, 3, 0), {{1e-9, {0.8, 0, 0.14}, {0, 3, 0}}});
+    Eigen::Vector3d v = hop.back().first;
+    for (std::size_t k = 1; k < hop.size(); ++k) tr.push_back(hop[k]);
+    for (int k = 0; k < static_cast<int>(1.0 / dt); ++k) {
+      const double vx = std::max(0.0, v.x() - 0.5 * 9.81 * dt);
+      v = Eigen::Vector3d(vx, 0, 0);
+      tr.emplace_back(v, Eigen::Vector3d(0, vx / 0.1, 0));
+    }
+    const FlightTop top = track(tr, dt, 0.01);
+    CHECK(top.contact());
+    CHECK_FALSE(top.found());
+  }
+  // Such drops are an atom below every speed and spin: a method whose bodies never fly again
+  // is as far from a reference whose bodies all do as KS allows, though the flights it has
+  // would match; the same share on both sides adds nothing.
+  std::vector<DropRun> ref(20), half(20), same(20);
+  for (int i = 0; i < 20; ++i) {
+    DropRun r;
+    r.config = 0;
+    r.impact = r.flight = true;
+    r.flight_speed = 0.5 + 0.05 * i;
+    r.flight_spin = 2.0 + 0.2 * i;
+    ref[static_cast<std::size_t>(i)] = same[static_cast<std::size_t>(i)] = r;
+    if (i % 2) r.flight = false;
+    half[static_cast<std::size_t>(i)] = r;
+  }
+  const Distances d = compare(half, ref, {}, {}, 1, 0);
+  CHECK(d.first_impact_ks_v.value >= 0.5);
+  CHECK(d.first_impact_ks_w.value >= 0.5);
+  for (std::size_t i = 0; i < 20; i += 2) same[i].flight = ref[i].flight = false;
+  CHECK(compare(same, ref, {}, {}, 1, 0).first_impact_ks.value == 0.0);
+}
+
+TEST_CASE("fidelity: rest time is compared over the drops that rest")
+{
+  // The reference: 30 drops resting after 1 to 2.45 s and 10 still rocking at the 10 s limit;
+  // the method: the same 30 and none at the limit. Over the drops that rest they agree.
+  std::vector<DropRun> ref, method;
+  for (int i = 0; i < 40; ++i) {
+    DropRun r;
+    r.config = 0;
+    r.rest_time = i < 30 ? 1.0 + 0.05 * i : 10.0;
+    r.time_limited = i >= 30;
+    ref.push_back(r);
+    if (i < 30) method.push_back(r);
+  }
+  CHECK(compare(method, ref, {}, {}, 1, 0).rest_time_w1.value == 0.0);
+  // A shift of 0.5 s of every resting drop is a W1 of 0.5 s over the reference's mean resting
+  // time, 1.725 s.
+  for (DropRun& r : method) r.rest_time += 0.5;
+  CHECK(compare(method, ref, {}, {}, 1, 0).rest_time_w1.value == doctest::Approx(0.5 / 1.725));
+  // No drop rests in the method: as far as can be said.
+  for (DropRun& r : method) r.time_limited = true;
+  CHECK(compare(method, ref, {}, {}, 1, 0).rest_time_w1.value == 1.0);
 }
 
 TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run")
@@ -296,6 +451,16 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
   for (const char* k : keys) CHECK(j.at("noise_floor").contains(k));
   CHECK(j.at("methods").at("statistical").at("table_bytes").get<long long>() > 0);
   CHECK(j.at("methods").at("sphere").at("table_bytes").is_null());
+  // The energy guard's clamp rate: statsim's responses counted, none for Bullet.
+  const nlohmann::json& stat = j.at("methods").at("statistical");
+  CHECK(stat.at("sample").at("statistical_responses").get<long long>() >= 8);  // one or more per drop
+  CHECK(stat.at("clamp_rate").get<double>() ==
+        doctest::Approx(stat.at("sample").at("energy_clamps").get<double>() /
+                        stat.at("sample").at("statistical_responses").get<double>()));
+  CHECK(j.at("methods").at("sphere").at("clamp_rate").is_null());
+  CHECK(j.at("methods").at("sphere").at("sample").at("statistical_responses").get<long long>() == 0);
+  for (const char* k : {"no_flight", "not_rested_share", "mean_flight_speed", "mean_flight_spin"})
+    CHECK(j.at("reference").contains(k));
   // The same drops as the reference: every distance is 0, except rest_height_err (and with it
   // summary_error), which measures heights against the reference's mean height per configuration
   // and so keeps the reference's own spread about that mean.

@@ -81,6 +81,10 @@ public:
     (void)i;
     return false;
   }
+  /// statsim: sampled responses applied so far (World::statistical_response_count); 0 elsewhere.
+  virtual std::uint64_t statistical_responses() const { return 0; }
+  /// statsim: of those, the ones the energy guard scaled down (World::energy_clamp_count).
+  virtual std::uint64_t energy_clamps() const { return 0; }
   // Measurements of `statsim stress`, read between steps; NaN where a method does not give them.
   /// Kinetic energy of all bodies, J.
   virtual double kinetic_energy() const { return std::numeric_limits<double>::quiet_NaN(); }

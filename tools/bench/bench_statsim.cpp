@@ -142,6 +142,8 @@ public:
   {
     return world_->body(static_cast<BodyId>(i)).state == MotionState::asleep;
   }
+  std::uint64_t statistical_responses() const override { return world_->statistical_response_count(); }
+  std::uint64_t energy_clamps() const override { return world_->energy_clamp_count(); }
   std::string warning() const override
   {
     if (worst_dropped_ == 0) return {};

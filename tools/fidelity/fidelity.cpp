@@ -22,23 +22,46 @@
 // vertical 0; centre of mass at x = y = 0 and height uniform in [R + 0.2, R + 1.0] m above the
 // plane z = 0, R the bounding radius. statsim worlds of run r are seeded with the same stream
 // seed. A run ends at rest: the body asleep (Bullet deactivation, statsim MotionState::asleep),
-// or max(|v|, |w| R) < 0.01 m/s for 0.5 s; or at --time-limit (10 s; counted). time_to_rest is
-// the start of the last uninterrupted stretch of steps, ending at rest, in which the body was
-// asleep or slower than 0.01 m/s.
+// or max(|v|, |w| R) < 0.01 m/s for 0.5 s; or at --time-limit (10 s; counted: the drop did not
+// rest). time_to_rest is the start of the last uninterrupted stretch of steps, ending at rest, in
+// which the body was asleep or slower than 0.01 m/s.
 //  - rest configuration: body-frame up R^T e_z, the nearest rest-pose normal of the signature
 //    by angle, "other" when more than 15 degrees from all. rest_tvd = 0.5 sum |p - p_ref| over
 //    the poses and "other".
 //  - rest_height_err = mean over the method's runs of |z_run - zref(c_run)| / R, zref(c) the
 //    reference's mean rest height in configuration c (its overall mean where it has no run in c).
 //  - travel: horizontal distance from drop point to rest point; travel_w1 = W1 / mean_ref(travel).
-//  - bounces: after the first contact (the first impact below), rises of the centre's height of
-//    at least h = max(0.01 m, 0.05 R) above the lowest height since the last counted rise; after
-//    a rise the centre must fall h below its highest point before the next can count.
-//    bounce_w1 = W1 / mean_ref(bounces) (mean 0: divided by 1); rest_time_w1 likewise.
-//  - first impact: the first step in which the vertical velocity rises by more than 2 |g| dt;
-//    the post-collision state is the state after that step for dt >= 1/60 s, and for smaller dt
-//    after the first later step without such a rise (an impact can span steps). KS statistics of
-//    |v+| and of |w+|; first_impact_ks is the larger. Runs without an impact are left out (counted).
+//  - bounces: after the first contact (below), rises of the centre's height of at least
+//    h = max(0.01 m, 0.05 R) above the lowest height since the last counted rise; after a rise
+//    the centre must fall h below its highest point before the next can count.
+//    bounce_w1 = W1 / mean_ref(bounces) (mean 0: divided by 1).
+//  - rest_time_w1 = W1 of time_to_rest over the drops that rested, in each sample, divided by the
+//    reference's mean over its drops that rested; the share that did not rest is reported for
+//    each sample beside it. A rigid body rocking on a curved side loses energy only at impacts
+//    and can rock past any time limit; its time to rest is unknown, and the time limit in its
+//    place would measure the limit. When only one sample has drops that rested: 1.
+//  - first_impact_ks: the tables describe a collision as everything from the first contact until
+//    the body has left the ground for good (a box landing on a corner strikes with a second and a
+//    third), and give the velocity and spin it leaves with. Each drop is measured at that event,
+//    whatever its step (FlightTop in fidelity.hpp): the first contact is the first step whose
+//    vertical velocity rises by more than 2 g dt; a step is free when the velocity changed by
+//    gravity alone (within 1% of g dt); the collision ends at the first flight, after the first
+//    contact, that leaves fast enough to rise h (v_z^2 / (2 g) >= h, the bounces' h) and stays
+//    free up to its top (v_z from > 0 to <= 0). Lower hops are part of the collision. The state
+//    compared is the one after the last step with a contact before that flight: engines apply
+//    gravity before they solve contacts, so that is the velocity and spin the body left with, at
+//    any step. (The state after the first step with a contact would be the first of several
+//    contact episodes at 1 ms but all of them at 1/60 s: it would measure the step as much as
+//    the response.) KS statistics of |v+| and of |w+|; first_impact_ks is the larger. A drop
+//    that never flies again after its first contact (it slides, rolls or rocks to rest) has no
+//    such state: it counts in both KS statistics as an atom below every speed and spin, so
+//    the difference between the shares of such drops (reported as "no flight") is part of the
+//    distance rather than left out.
+//  - clamp rate (statsim methods): the energy guard's clamped sampled responses over all sampled
+//    responses applied (World::energy_clamp_count / statistical_response_count), summed over the
+//    single drops (and, in the JSON, over the piles).
+// Method full-gather: Bullet full with the reference's settings at --dt, to tell the step's
+// effect from the settings' (its piles and step time use statsim bench's settings, as full).
 // Piles: drop_scene3(count = --pile-count, seed s) for s = 1..--pile-seeds (reference floor:
 // seeds pile-seeds+1..2 pile-seeds), run until every body rests (asleep, or slower than
 // 0.01 m/s for 0.5 s) or the time limit. pile_radial_w1: W1 of the bodies' horizontal
@@ -128,20 +151,66 @@ const char* fidelity_definitions()
          "Single drops: run r has its own stream; orientation uniform on SO(3), angular velocity components uniform "
          "in +-5 rad/s, horizontal velocity components uniform in +-0.5 m/s, centre at x=y=0 and height uniform in "
          "[R+0.2, R+1.0] m (R: bounding radius). A run ends when the body is asleep or max(|v|,|w|R) < 0.01 m/s for "
-         "0.5 s, or at --time-limit (counted); time_to_rest = start of the last uninterrupted stretch asleep or "
-         "below 0.01 m/s.\n"
+         "0.5 s, or at --time-limit (counted as not rested); time_to_rest = start of the last uninterrupted stretch "
+         "asleep or below 0.01 m/s.\n"
          "rest_tvd: body-frame up R^T e_z, nearest rest-pose normal of the signature (the shape's compiled table, or "
          "the first --table), 'other' beyond 15 degrees; "
          "0.5 sum |p - p_ref|. rest_height_err: mean |z - zref(c)| / R, zref(c) the reference's mean rest height in "
          "configuration c (overall mean if none). travel_w1: W1 of horizontal drop-to-rest distance / reference "
-         "mean. bounce_w1: bounces = rises of the centre of at least max(0.01 m, 0.05 R) above the preceding "
-         "minimum after the first contact (hysteresis), W1 / reference mean (1 if 0); rest_time_w1 likewise. "
-         "first_impact_ks: first step whose vertical velocity rises by more than 2|g|dt; state after it (dt >= "
-         "1/60) or after the next step without such a rise; max of the KS statistics of |v+| and |w+|.\n"
+         "mean. bounce_w1: bounces = rises of the centre of at least h = max(0.01 m, 0.05 R) above the preceding "
+         "minimum after the first contact (hysteresis), W1 / reference mean (1 if 0). rest_time_w1: W1 of "
+         "time_to_rest over the drops that rested in each sample / the reference's mean over its rested drops "
+         "(1 if only one sample has rested drops); 'not rested' gives each sample's share at the time limit.\n"
+         "first_impact_ks: the state the tables describe, the velocity and spin the body leaves the ground with "
+         "once its first collision (every contact episode from the first contact until it has left for good) is "
+         "over, at any step: first contact = first step whose vertical velocity rises by more than 2|g|dt; free "
+         "step = velocity changed by gravity alone (within 1% of |g|dt); the collision ends at the first flight that "
+         "leaves with v_z^2/(2|g|) >= h and stays free up to its top; the state compared is the one after the last "
+         "step with a contact before it. Max of the KS statistics of |v+| and |w+|; drops that never fly again after "
+         "the first contact count as an atom below every value (their share: 'no flight').\n"
+         "clamp rate (statsim): sampled responses scaled down by the energy guard / sampled responses applied, "
+         "summed over the single drops. Method full-gather: Bullet full with the reference's settings at --dt "
+         "(piles and step time: statsim bench's settings).\n"
          "Piles: drop_scene3(--pile-count bodies, seeds 1..N) until all rest or the time limit: W1 of distances from the "
          "pile centroid / reference mean, W1 of centre heights / reference mean, rest_tvd pooled over bodies.\n"
          "Intervals: percentile bootstrap, 200 resamples of both samples (piles: seeds), 90%. step_ms: thread CPU "
          "time per step on the benchmark scene (drop_scene3, --bench-n bodies, --bench-steps steps at 1/60 s).";
+}
+
+// ---- the end of the first collision -------------------------------------------------------------
+
+FlightTop::FlightTop(double dt, double min_rise, double gravity) : dt_(dt), min_rise_(min_rise), gravity_(gravity) {}
+
+void FlightTop::add(const Eigen::Vector3d& velocity, const Eigen::Vector3d& spin)
+{
+  ++steps_;
+  const Eigen::Vector3d prev = prev_v_;
+  prev_v_ = velocity;
+  if (steps_ == 0 || found_) return;
+  const double g_dt = gravity_ * dt_;
+  // Over a free step v_k = v_(k-1) - g dt e_z; what is left is the impulse of the contacts over
+  // the step, per unit mass.
+  const Eigen::Vector3d kick = velocity - prev + Eigen::Vector3d(0, 0, g_dt);
+  if (contact_step_ < 0) {
+    if (velocity.z() - prev.z() <= 2 * g_dt) return;
+    contact_step_ = steps_;
+  }
+  if (kick.norm() > kFreeTolerance * g_dt) {
+    // Whatever the step, the velocity after the last step with a contact is the one the body
+    // leaves with: engines apply gravity before they solve the contacts.
+    leave_v_ = velocity;
+    leave_w_ = spin;
+    return;
+  }
+  // The top of a free flight: from there the body left with leave_v_, and its centre rose
+  // v_z^2 / (2 g) since, whatever the step.
+  const double rise = leave_v_.z() > 0 ? leave_v_.z() * leave_v_.z() / (2 * gravity_) : 0.0;
+  if (prev.z() > 0 && velocity.z() <= 0 && rise >= min_rise_) {
+    found_ = true;
+    speed_ = leave_v_.norm();
+    spin_ = leave_w_.norm();
+    rise_ = rise;
+  }
 }
 
 // ---- distances -----------------------------------------------------------------------------------
@@ -168,6 +237,25 @@ std::vector<double> column(const std::vector<DropRun>& runs, F f)
 double guard(double m)
 {
   return m > 0 ? m : 1.0;
+}
+
+// Stands for "no flight" in the samples of leaving speeds and spins (both are >= 0).
+constexpr double kNoFlight = -1.0;
+
+// W1 of the times to rest of the drops that rest in each sample, over the reference's mean: a
+// body that is still rocking at the time limit has no time to rest to compare (a rigid bunny on
+// its curved back loses energy only at impacts and can rock on far past any limit), so those
+// are left out on both sides, and their shares are reported beside. When only one sample has
+// drops that rest, as far apart as can be said: 1.
+double rest_time_distance(const std::vector<DropRun>& m, const std::vector<DropRun>& ref)
+{
+  std::vector<double> a, b;
+  for (const DropRun& r : m)
+    if (!r.time_limited) a.push_back(r.rest_time);
+  for (const DropRun& r : ref)
+    if (!r.time_limited) b.push_back(r.rest_time);
+  if (a.empty() || b.empty()) return a.empty() && b.empty() ? 0.0 : 1.0;
+  return w1(a, b) / guard(mean(b));
 }
 
 struct DropStats {
@@ -204,17 +292,16 @@ DropStats drop_stats(const std::vector<DropRun>& m, const std::vector<DropRun>& 
 
   auto travel = [](const DropRun& r) { return r.travel; };
   auto bounces = [](const DropRun& r) { return r.bounces; };
-  auto rest_time = [](const DropRun& r) { return r.rest_time; };
   s.travel = w1(column(m, travel), column(ref, travel)) / guard(mean(column(ref, travel)));
   s.bounce = w1(column(m, bounces), column(ref, bounces)) / guard(mean(column(ref, bounces)));
-  s.rest_time = w1(column(m, rest_time), column(ref, rest_time)) / guard(mean(column(ref, rest_time)));
-  std::vector<double> mv, mw, rv, rw;
-  for (const DropRun& r : m)
-    if (r.impact) mv.push_back(r.impact_speed), mw.push_back(r.impact_spin);
-  for (const DropRun& r : ref)
-    if (r.impact) rv.push_back(r.impact_speed), rw.push_back(r.impact_spin);
-  s.ks_v = ks(mv, rv);
-  s.ks_w = ks(mw, rw);
+  s.rest_time = rest_time_distance(m, ref);
+  // A drop without a flight after its first contact is an atom below every speed: the KS
+  // statistic then also sees a difference in how often the body flies again, which leaving
+  // those drops out would hide.
+  auto speed = [](const DropRun& r) { return r.flight ? r.flight_speed : kNoFlight; };
+  auto spin = [](const DropRun& r) { return r.flight ? r.flight_spin : kNoFlight; };
+  s.ks_v = ks(column(m, speed), column(ref, speed));
+  s.ks_w = ks(column(m, spin), column(ref, spin));
   return s;
 }
 
@@ -498,35 +585,24 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
 
   DropRun out;
   const scenes::BodyState3 start = scene.bodies[0];
-  scenes::BodyState3 prev = sim->body_state(0);
-  const double rise = 2 * kGravity * dt;
-  const bool coarse = dt >= 1.0 / 60.0 - 1e-12;
+  scenes::BodyState3 s = sim->body_state(0);
   const double hysteresis = std::max(0.01, 0.05 * R);
-  bool contact = false, pending = false, rising = false;
+  FlightTop top(dt, hysteresis, kGravity);
+  top.add(s.linear_velocity, s.angular_velocity);
+  bool rising = false;
   double low = 0, high = 0;
   double still_since = -1, quiet_since = -1;
   const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));
-  scenes::BodyState3 s = prev;
   double t = 0;
   bool rested = false;
   for (long k = 1; k <= steps; ++k) {
     sim->step();
     t = static_cast<double>(k) * dt;
     s = sim->body_state(0);
-    const bool up_kick = s.linear_velocity.z() - prev.linear_velocity.z() > rise;
-    if (!contact && up_kick) {
-      contact = true;
-      low = s.position.z();
-      if (coarse) {
-        out.impact = true, out.impact_speed = s.linear_velocity.norm(), out.impact_spin = s.angular_velocity.norm();
-      } else {
-        pending = true;
-      }
-    } else if (pending && !up_kick) {
-      pending = false;
-      out.impact = true, out.impact_speed = s.linear_velocity.norm(), out.impact_spin = s.angular_velocity.norm();
-    }
-    if (contact) {
+    const bool contact = top.contact();
+    top.add(s.linear_velocity, s.angular_velocity);
+    if (!contact && top.contact()) low = s.position.z();
+    if (top.contact()) {
       const double z = s.position.z();
       if (!rising) {
         low = std::min(low, z);
@@ -548,12 +624,17 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
     } else {
       quiet_since = -1;
     }
-    prev = s;
     if (asleep || (quiet_since >= 0 && t - quiet_since >= kQuietTime - 1e-9)) {
       rested = true;
       break;
     }
   }
+  out.impact = top.contact();
+  out.flight = top.found();
+  out.flight_speed = top.speed();
+  out.flight_spin = top.spin();
+  out.responses = sim->statistical_responses();
+  out.clamps = sim->energy_clamps();
   out.time_limited = !rested;
   out.rest_time = rested ? still_since : t;
   out.config = classify(s.orientation, setup.poses);
@@ -570,7 +651,9 @@ PileRun run_pile(const Setup& setup, const MethodSpec& m, std::uint64_t seed, in
   o.bounding_radius = setup.radius;
   o.seed = seed;
   const scenes::DropScene3 scene = scenes::drop_scene3(o);
-  std::unique_ptr<bench::Sim> sim = build(setup, m, scene, world_seed, dt);
+  MethodSpec many = m;
+  many.gather_reference = false;  // GatherReferenceSim holds one body
+  std::unique_ptr<bench::Sim> sim = build(setup, many, scene, world_seed, dt);
   const std::size_t n = scene.bodies.size();
   std::vector<double> quiet_since(n, -1);
   const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));
@@ -598,6 +681,8 @@ PileRun run_pile(const Setup& setup, const MethodSpec& m, std::uint64_t seed, in
     }
   }
   out.seconds = t;
+  out.responses = sim->statistical_responses();
+  out.clamps = sim->energy_clamps();
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   for (const auto& b : s) c += b.position.head<2>();
   c /= static_cast<double>(n);
@@ -616,7 +701,9 @@ double measure_step_ms(const Setup& setup, const MethodSpec& m, int n, int steps
   o.bounding_radius = setup.radius;
   o.seed = 1;
   const scenes::DropScene3 scene = scenes::drop_scene3(o);
-  std::unique_ptr<bench::Sim> sim = build(setup, m, scene, 1, 1.0 / 60.0);
+  MethodSpec many = m;
+  many.gather_reference = false;  // GatherReferenceSim holds one body
+  std::unique_ptr<bench::Sim> sim = build(setup, many, scene, 1, 1.0 / 60.0);
   const double t0 = bench::thread_cpu_ms();
   for (int k = 0; k < steps; ++k) sim->step();
   return (bench::thread_cpu_ms() - t0) / steps;
@@ -672,7 +759,8 @@ Setup make_setup(const FidelityOptions& o)
     s.body = body_from_mesh(o.mesh, s.loaded.front().view());
   }
   s.radius = s.body.bounding_radius;
-  if (o.reference == "gather") {
+  const std::vector<std::string> names = o.methods.empty() ? default_methods() : o.methods;
+  if (o.reference == "gather" || std::find(names.begin(), names.end(), "full-gather") != names.end()) {
     // The gathering's defaults (tables/NAME.hpp's header lists them) at the body's density.
     const std::string shape = o.mesh.empty() ? o.shape : std::string();
     s.model = std::make_unique<ref3d::ShapeModel>(ref3d::load_shape_model(shape, o.mesh, 1000.0));
@@ -685,7 +773,6 @@ Setup make_setup(const FidelityOptions& o)
       have_compiled ? static_cast<long long>(signature_bytes(compiled)) : static_cast<long long>(s.loaded.front().bytes());
   const std::string base_name = have_compiled ? s.body.table_name : s.loaded.front().path;
 
-  const std::vector<std::string> names = o.methods.empty() ? default_methods() : o.methods;
   auto shapes = bench::make_bullet_shapes(s.body);
   for (const std::string& name : names) {
     MethodSpec m;
@@ -699,6 +786,11 @@ Setup make_setup(const FidelityOptions& o)
       m.bullet = true;
       m.bullet_method = name;
       m.description = "Bullet " + name;
+    } else if (name == "full-gather") {
+      m.bullet = true;
+      m.gather_reference = true;
+      m.bullet_method = "full";
+      m.description = "Bullet full, statsim gather's settings (piles and step time: statsim bench's)";
     } else if (name == "statistical" || name == "statistical-norest" || name == "statistical-independent") {
       m.table = base;
       m.table_bytes = base_bytes;
@@ -717,7 +809,7 @@ Setup make_setup(const FidelityOptions& o)
       m.description = "statsim, " + it->path + (it->i16() ? " (i16)" : " (f32)");
     } else {
       throw std::invalid_argument("unknown method '" + name +
-                                  "' (full, low, hull, spheres7, sphere, statistical, statistical-norest, "
+                                  "' (full, full-gather, low, hull, spheres7, sphere, statistical, statistical-norest, "
                                   "statistical-independent, statistical:NAME)");
     }
     s.methods.push_back(m);

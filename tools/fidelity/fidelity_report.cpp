@@ -59,31 +59,56 @@ json distances_json(const Distances& d)
   return j;
 }
 
+// The energy guard's clamp rate: clamped / applied sampled responses, summed over the runs.
+struct ClampRate {
+  std::uint64_t responses = 0, clamps = 0;
+  double rate() const { return responses ? static_cast<double>(clamps) / static_cast<double>(responses) : 0.0; }
+};
+
+template <class Run>
+ClampRate clamp_rate(const std::vector<Run>& runs)
+{
+  ClampRate c;
+  for (const Run& r : runs) c.responses += r.responses, c.clamps += r.clamps;
+  return c;
+}
+
 json sample_json(const MethodResult& m, int configs)
 {
   json j;
   j["description"] = m.description;
   j["dt"] = m.dt;
   j["runs"] = m.drops.size();
-  std::size_t limited = 0, no_impact = 0;
+  std::size_t limited = 0, no_impact = 0, no_flight = 0;
   std::vector<double> hist(static_cast<std::size_t>(configs), 0.0);
-  std::vector<double> travel, bounces, rest_time, height;
+  std::vector<double> travel, bounces, rest_time, height, flight_speed, flight_spin;
   for (const DropRun& r : m.drops) {
     limited += r.time_limited;
     no_impact += !r.impact;
+    no_flight += !r.flight;
     hist[static_cast<std::size_t>(r.config)] += 1.0 / static_cast<double>(m.drops.size());
     travel.push_back(r.travel);
     bounces.push_back(r.bounces);
-    rest_time.push_back(r.rest_time);
+    if (!r.time_limited) rest_time.push_back(r.rest_time);
     height.push_back(r.rest_height);
+    if (r.flight) flight_speed.push_back(r.flight_speed), flight_spin.push_back(r.flight_spin);
   }
   j["time_limited"] = limited;
+  j["not_rested_share"] = m.drops.empty() ? 0.0 : static_cast<double>(limited) / static_cast<double>(m.drops.size());
   j["no_impact"] = no_impact;
+  j["no_flight"] = no_flight;
   j["rest_histogram"] = hist;
   j["mean_travel"] = mean(travel);
   j["mean_bounces"] = mean(bounces);
-  j["mean_rest_time"] = mean(rest_time);
+  j["mean_rest_time"] = mean(rest_time);  // over the drops that rested
   j["mean_rest_height_over_R"] = mean(height);
+  j["mean_flight_speed"] = mean(flight_speed);
+  j["mean_flight_spin"] = mean(flight_spin);
+  const ClampRate drops = clamp_rate(m.drops);
+  j["statistical_responses"] = drops.responses;
+  j["energy_clamps"] = drops.clamps;
+  if (drops.responses > 0) j["clamp_rate"] = drops.rate();
+  else j["clamp_rate"] = nullptr;
   if (!m.piles.empty()) {
     std::size_t pl = 0;
     double secs = 0;
@@ -91,6 +116,11 @@ json sample_json(const MethodResult& m, int configs)
     j["pile_seeds"] = m.piles.size();
     j["pile_time_limited"] = pl;
     j["pile_mean_seconds"] = secs / static_cast<double>(m.piles.size());
+    const ClampRate piles = clamp_rate(m.piles);
+    j["pile_statistical_responses"] = piles.responses;
+    j["pile_energy_clamps"] = piles.clamps;
+    if (piles.responses > 0) j["pile_clamp_rate"] = piles.rate();
+    else j["pile_clamp_rate"] = nullptr;
   }
   return j;
 }
@@ -183,6 +213,9 @@ std::string fidelity_json(const FidelityResult& r)
     else x["step_ms"] = nullptr;
     if (m.table_bytes >= 0) x["table_bytes"] = m.table_bytes;
     else x["table_bytes"] = nullptr;
+    const ClampRate c = clamp_rate(m.drops);
+    if (c.responses > 0) x["clamp_rate"] = c.rate();
+    else x["clamp_rate"] = nullptr;
     x["sample"] = sample_json(m, configs);
     methods[m.name] = x;
   }
@@ -203,33 +236,53 @@ std::string fidelity_table(const FidelityResult& r)
   if (r.options.piles)
     s << " (piles: at " << num(r.options.pile_reference_dt, "%.5g") << " s with the settings of statsim bench)";
   s << "; methods at dt " << num(r.options.dt, "%.5g") << " s. Distances with 90% bootstrap intervals.\n\n";
-  s << "| method | rest_tvd | rest_height_err | travel_w1 | bounce_w1 | rest_time_w1 | first_impact_ks (v, w) |";
+  s << "| method | rest_tvd | rest_height_err | travel_w1 | bounce_w1 | rest_time_w1 | not rested | "
+       "first_impact_ks (v, w) | no flight |";
   if (r.options.piles) s << " pile radial_w1 | pile height_w1 | pile rest_tvd |";
-  s << " step_ms | table_bytes | summary_error |\n|---|---|---|---|---|---|---|";
+  s << " clamp rate | step_ms | table_bytes | summary_error |\n|---|---|---|---|---|---|---|---|---|";
   if (r.options.piles) s << "---|---|---|";
-  s << "---|---|---|\n";
-  auto row = [&](const std::string& name, const Distances& d, double step_ms, long long bytes) {
+  s << "---|---|---|---|\n";
+  auto share = [](const MethodResult& m, bool (*f)(const DropRun&)) {
+    std::size_t n = 0;
+    for (const DropRun& d : m.drops) n += f(d);
+    return m.drops.empty() ? 0.0 : static_cast<double>(n) / static_cast<double>(m.drops.size());
+  };
+  auto row = [&](const std::string& name, const Distances& d, const MethodResult& m, double step_ms, long long bytes) {
+    const ClampRate c = clamp_rate(m.drops);
     s << "| " << name << " | " << with_ci(d.rest_tvd) << " | " << with_ci(d.rest_height_err) << " | "
       << with_ci(d.travel_w1) << " | " << with_ci(d.bounce_w1) << " | " << with_ci(d.rest_time_w1) << " | "
-      << with_ci(d.first_impact_ks) << " (" << num(d.first_impact_ks_v.value) << ", "
-      << num(d.first_impact_ks_w.value) << ") |";
+      << num(share(m, [](const DropRun& x) { return x.time_limited; })) << " | " << with_ci(d.first_impact_ks)
+      << " (" << num(d.first_impact_ks_v.value) << ", " << num(d.first_impact_ks_w.value) << ") | "
+      << num(share(m, [](const DropRun& x) { return !x.flight; })) << " |";
     if (r.options.piles)
       s << " " << with_ci(d.pile_radial_w1) << " | " << with_ci(d.pile_height_w1) << " | "
         << with_ci(d.pile_rest_tvd) << " |";
-    s << " " << (step_ms >= 0 ? num(step_ms, "%.4g") : "-") << " | "
-      << (bytes >= 0 ? std::to_string(bytes) : "-") << " | " << with_ci(d.summary_error) << " |\n";
+    s << " " << (c.responses ? num(c.rate(), "%.4f") : "-") << " | " << (step_ms >= 0 ? num(step_ms, "%.4g") : "-")
+      << " | " << (bytes >= 0 ? std::to_string(bytes) : "-") << " | " << with_ci(d.summary_error) << " |\n";
   };
-  for (const MethodResult& m : r.methods) row(m.name, m.d, m.step_ms, m.table_bytes);
-  row("noise floor (reference B vs A)", r.noise_floor, -1, -1);
-  s << "\n";
+  for (const MethodResult& m : r.methods) row(m.name, m.d, m, m.step_ms, m.table_bytes);
+  row("noise floor (reference B vs A)", r.noise_floor, r.reference_b, -1, -1);
+  s << "\n'not rested' and 'no flight' are the method's shares (the noise floor's row: reference B's); reference A: "
+    << num(share(r.reference, [](const DropRun& x) { return x.time_limited; })) << " not rested, "
+    << num(share(r.reference, [](const DropRun& x) { return !x.flight; }))
+    << " no flight. 'clamp rate': sampled responses scaled down by the energy guard / those applied, over the single "
+       "drops.\n\n";
   auto counts = [&](const MethodResult& m) {
-    std::size_t limited = 0, no_impact = 0;
-    for (const DropRun& d : m.drops) limited += d.time_limited, no_impact += !d.impact;
+    std::size_t limited = 0, no_impact = 0, no_flight = 0;
+    for (const DropRun& d : m.drops) limited += d.time_limited, no_impact += !d.impact, no_flight += !d.flight;
     std::size_t pl = 0;
     for (const PileRun& p : m.piles) pl += p.time_limited;
     s << "- " << m.name << " (" << m.description << "): " << limited << " of " << m.drops.size()
-      << " drops hit the time limit, " << no_impact << " without a first impact";
-    if (!m.piles.empty()) s << "; " << pl << " of " << m.piles.size() << " piles hit the time limit";
+      << " drops hit the time limit, " << no_impact << " without a first contact, " << no_flight
+      << " without a flight after it";
+    const ClampRate c = clamp_rate(m.drops);
+    if (c.responses)
+      s << "; energy guard: " << c.clamps << " of " << c.responses << " sampled responses clamped";
+    if (!m.piles.empty()) {
+      s << "; " << pl << " of " << m.piles.size() << " piles hit the time limit";
+      const ClampRate p = clamp_rate(m.piles);
+      if (p.responses) s << ", " << p.clamps << " of " << p.responses << " pile responses clamped";
+    }
     s << "\n";
   };
   counts(r.reference);
@@ -299,9 +352,10 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--table", *table_args,
                   "NAME=FILE.json (statsim gather --json): adds method statistical:NAME; repeatable");
   cmd->add_option("--methods", *method_list,
-                  "comma-separated: full, low, hull, spheres7, sphere, statistical, statistical-norest, "
-                  "statistical-independent, statistical:NAME (default: full,low,spheres7,sphere,statistical,"
-                  "statistical-norest,statistical-independent)");
+                  "comma-separated: full, full-gather (Bullet full with the gathering's settings at --dt: the "
+                  "reference's engine at the methods' step), low, hull, spheres7, sphere, statistical, "
+                  "statistical-norest, statistical-independent, statistical:NAME (default: "
+                  "full,low,spheres7,sphere,statistical,statistical-norest,statistical-independent)");
   cmd->add_option("--runs", opts->runs, "single drops per sample")->capture_default_str();
   cmd->add_option("--dt", *dt_text, "step of the methods, s (a number or 1/N)")->capture_default_str();
   cmd->add_option("--reference-dt", *reference_dt_text, "step of the reference in single drops, s (a number or 1/N)")
