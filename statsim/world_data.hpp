@@ -92,7 +92,7 @@ template <int D>
 void hash_def(Fnv1a& h, const WorldDef<D>& d)
 {
   h.add_vec(d.gravity);
-  h.add_all(d.seed, d.restitution_threshold, d.settle_speed, d.sleep_speed, d.sleep_time, d.wake_speed,
+  h.add_all(d.seed, d.restitution_threshold, std::uint8_t(d.table_restitution_threshold), d.settle_speed, d.sleep_speed, d.sleep_time, d.wake_speed,
             d.linear_damping, d.angular_damping, std::int32_t(d.support_iterations),
             std::uint8_t(d.shock_propagation), std::int32_t(d.position_iterations), d.allowed_overlap,
             d.overlap_correction, d.spin_ratio_speed_floor, std::uint8_t(d.nearest_radius),
