@@ -98,8 +98,9 @@ struct WorldDef {
   Scalar restitution_threshold = Scalar(0.5);
   /// Statistical bodies that were not settling at the end of the last step take the statistical
   /// response at contacts approaching faster than their table's restitution threshold
-  /// (`Signature::restitution_threshold`, m/s; 0.02 in the committed tables), the threshold the
-  /// reference bounced with when the table was gathered, instead of `restitution_threshold`.
+  /// (`Signature::restitution_threshold`, m/s; 0.02 in the committed 3D tables, Box2D's 1 in the
+  /// 2D ones), the threshold the reference bounced with when the table was gathered, instead of
+  /// `restitution_threshold`.
   /// Settling bodies (touching and slower than `settle_speed`) keep `restitution_threshold`: a
   /// body resting on the ground or on other bodies approaches at |g| dt every step, and a sampled
   /// response there would keep it from ever settling. Off: every contact uses
