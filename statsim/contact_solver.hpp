@@ -54,8 +54,14 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
   Vec v = b.linear_velocity - other_velocity;
   // A contact approaching slower than the restitution threshold is resting, not a collision:
   // the tables describe collisions, and sampling a fresh spin at every resting step would
-  // keep a body from ever settling. It gets the inelastic particle response instead.
-  const bool resting = -v.dot(n) <= def.restitution_threshold;
+  // keep a body from ever settling. It gets the inelastic particle response instead. A body
+  // that is not settling bounces as the reference did when the table was gathered, down to the
+  // table's threshold; a settling one approaches at |g| dt each step while it rests, so it
+  // keeps the world's.
+  const bool table_threshold =
+      shape.statistical && def.table_restitution_threshold && b.state != MotionState::settling;
+  const Scalar threshold = table_threshold ? shape.signature.restitution_threshold : def.restitution_threshold;
+  const bool resting = -v.dot(n) <= threshold;
   if (!shape.statistical || (resting && !(ground_contact && b.rest_pose != no_rest_pose))) {
     particle_plane_response<D>(v, b.angular_velocity, contact_radius(w, b), n, shape.material,
                                def.restitution_threshold);

@@ -98,7 +98,7 @@ void hash_def(Fnv1a& h, const WorldDef<D>& d)
             d.overlap_correction, d.spin_ratio_speed_floor, std::uint8_t(d.nearest_radius),
             std::uint8_t(d.pair_response), std::uint8_t(d.rest_conditions), std::uint8_t(d.pile_rest),
             d.rest_blend_time, d.rest_turn_time, d.rest_snap_cosine, d.ground_cosine, std::uint8_t(d.broad_phase),
-            d.grid_above_bodies, std::int32_t(d.sweep_axis));
+            d.grid_above_bodies, std::int32_t(d.sweep_axis), std::uint8_t(d.table_restitution_threshold));
 }
 
 /// Adds a table's numbers as the runtime reads them (16-bit ones as their values).

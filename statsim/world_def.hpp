@@ -93,8 +93,19 @@ struct WorldDef {
   /// Seed of every random stream; body i draws from stream `body_stream(seed, i)`.
   std::uint64_t seed = 0x5eed5eedull;
   /// Approach speed below which contacts do not bounce, m/s. Keep it above |g| dt (0.16 at
-  /// 60 Hz) so that resting bodies do not jitter.
+  /// 60 Hz) so that resting bodies do not jitter. Statistical bodies use it only while settling
+  /// (see `table_restitution_threshold`).
   Scalar restitution_threshold = Scalar(0.5);
+  /// Statistical bodies that were not settling at the end of the last step take the statistical
+  /// response at contacts approaching faster than their table's restitution threshold
+  /// (`Signature::restitution_threshold`, m/s; 0.02 in the committed 3D tables, Box2D's 1 in the
+  /// 2D ones), the threshold the reference bounced with when the table was gathered, instead of
+  /// `restitution_threshold`.
+  /// Settling bodies (touching and slower than `settle_speed`) keep `restitution_threshold`: a
+  /// body resting on the ground or on other bodies approaches at |g| dt every step, and a sampled
+  /// response there would keep it from ever settling. Off: every contact uses
+  /// `restitution_threshold`.
+  bool table_restitution_threshold = true;
   /// A touching body slower than this is settling, m/s (speed = max(|v|, |w| R_bound)).
   Scalar settle_speed = Scalar(0.5);
   /// A touching body slower than this for `sleep_time` falls asleep, m/s. Its linear speed

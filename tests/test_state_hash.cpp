@@ -51,6 +51,7 @@ TEST_CASE("state_hash differs for worlds that differ in any parameter, material 
         {"gravity", [](WorldDef3& d) { d.gravity = Vector3(0, 0, -9.8f); }},
         {"seed", [](WorldDef3& d) { d.seed = 7; }},
         {"restitution_threshold", [](WorldDef3& d) { d.restitution_threshold = 0.6f; }},
+        {"table_restitution_threshold", [](WorldDef3& d) { d.table_restitution_threshold = false; }},
         {"settle_speed", [](WorldDef3& d) { d.settle_speed = 0.6f; }},
         {"sleep_speed", [](WorldDef3& d) { d.sleep_speed = 0.06f; }},
         {"sleep_time", [](WorldDef3& d) { d.sleep_time = 0.6f; }},

@@ -235,6 +235,57 @@ TEST_CASE("bunny resting conditions off vs on - in a pose at h_rest only with th
   }
 }
 
+TEST_CASE("slow contacts of statistical bodies bounce down to the table's threshold - and the bodies still sleep")
+{
+  // Bunnies 6 m apart land at 0.3 m/s (0.46 m/s once the step's gravity is added): above the
+  // table's threshold (0.02 m/s, as gathered), below the world's (0.5 m/s). With the table's
+  // threshold the landing is a collision, sampled from the table; with the world's it is
+  // inelastic and nothing leaves the ground. Either way every body comes to rest.
+  const SignatureView<3> sig = tables::bunny.view();
+  REQUIRE(sig.restitution_threshold < 0.1f);
+  for (const bool table : {true, false}) {
+    CAPTURE(table);
+    WorldDef3 def;
+    def.table_restitution_threshold = table;
+    auto w = std::make_unique<World3<32>>(def);
+    const ShapeId shape = w->add_shape(sig).id;
+    REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+    Pcg32 g(16, 4);
+    const int n = 20;
+    for (int i = 0; i < n; ++i) {
+      BodyDef3 b;
+      b.shape = shape;
+      b.orientation = random_orientation(g);
+      b.linear_velocity = Vector3(0, 0, -0.3f);
+      // Touching the ground after one step: the centre falls 0.46 / 60 m.
+      b.position = Vector3(6.0f * float(i), 0, collision_radius<3>(sig, b.linear_velocity, Vector3::Zero()) + 0.002f);
+      REQUIRE(w->add_body(b).ok());
+    }
+    REQUIRE(w->step(1.0f / 60).ok());
+    int rising = 0;
+    for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+      CHECK(w->body(i).touching);
+      rising += w->body(i).linear_velocity.z() > 0.05f;
+    }
+    MESSAGE("table threshold " << table << ": " << w->statistical_response_count() << " sampled responses, "
+                               << rising << " of " << n << " leave the ground");
+    if (table) {
+      CHECK(w->statistical_response_count() == std::uint64_t(n));
+      CHECK(rising >= n / 2);
+    } else {
+      CHECK(w->statistical_response_count() == 0);
+      CHECK(rising == 0);
+    }
+    for (int s = 0; s < 60 * 10 && w->count(MotionState::asleep) < w->body_count(); ++s) REQUIRE(w->step(1.0f / 60).ok());
+    CHECK(w->count(MotionState::asleep) == w->body_count());
+    for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+      const Body3& b = w->body(i);
+      REQUIRE(b.rest_pose < sig.rest.count);
+      CHECK(b.position.z() == doctest::Approx(sig.rest.heights[b.rest_pose]).epsilon(0.01));
+    }
+  }
+}
+
 TEST_CASE("cubes with the gathered box table rest face down at half the side")
 {
   const SignatureView<3> sig = tables::box.view();
