@@ -15,10 +15,11 @@
 //   no gravity, dt 1/480 s, 8 velocity / 3 position iterations, random orientation at a fixed height, until separated;
 //   1875 trials had not separated 3 s after first contact (time limit; their final velocities are used)
 // rest poses (paper 3.2.3): 2000 drops with gravity 9.81 m/s^2, dt 1/120 s, until Box2D put the body to sleep; 0 were still awake after 30 s;
-//   greedy clustering of body-frame up vectors at 10 degrees, snapped to hull faces within 3 degrees; kept: frequency > 0.05; h_rest on the core shape
-//   pose 0: up (-0.707107, -0.707107) h_rest 0.404061 m, 788 drops, frequency 0.3940
-//   pose 1: up (1.000000, 0.000000) h_rest 0.339286 m, 622 drops, frequency 0.3110
-//   pose 2: up (0.000000, 1.000000) h_rest 0.339286 m, 590 drops, frequency 0.2950
+//   greedy clustering of body-frame up vectors at 10 degrees, snapped to hull faces within 3 degrees; kept: families (poses equivalent under the shape's symmetry) of frequency > 0.05, then rarer ones while more than 0.02 of the settled drops is dropped; h_rest on the core shape
+//   pose 0: up (-0.707107, -0.707107) h_rest 0.404061 m, 788 drops, frequency 0.3940, family 1
+//   pose 1: up (1.000000, 0.000000) h_rest 0.339286 m, 622 drops, frequency 0.3110, family 0
+//   pose 2: up (0.000000, 1.000000) h_rest 0.339286 m, 590 drops, frequency 0.2950, family 0
+//   dropped: 0.0000 of the settled drops
 #pragma once
 
 #include "statsim/signature.hpp"
@@ -27,7 +28,8 @@ static_assert(STATSIM_TABLE_FORMAT_VERSION == 2, "tables/lshape2d.hpp was genera
 
 namespace statsim::tables {
 
-// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses>
+// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,
+//           spread values per cell (the paper's model: one standard deviation per component)>
 inline constexpr Signature<2, 16, 7, 9, 5, 1, 3, 3> lshape2d = {
     "lshape2d",
     0x1.7c4804p-1f,  // length L (bounding radius), m
@@ -236,7 +238,7 @@ inline constexpr Signature<2, 16, 7, 9, 5, 1, 3, 3> lshape2d = {
         0x1.f73cp-1f, -0x1.3947a8p-1f, 0x1.e2968cp-1f, 0x1.cc0304p-1f, -0x1.151402p-1f, 0x1.f6125cp-1f,
         0x1.d168d8p-1f, -0x1.17f90cp-1f, 0x1.f2fdfcp-1f
     }},
-    // response_stddev
+    // response_spread: per cell the standard deviation of each component
     {{
         0x1.0e1902p+0f, 0x1.4d913ep-3f, 0x1.625784p-2f, 0x1.f5b84cp-1f, 0x1.450bcp-3f, 0x1.485222p-2f,
         0x1.fa9142p-1f, 0x1.48a098p-3f, 0x1.4b362ep-2f, 0x1.f0e472p-1f, 0x1.439594p-3f, 0x1.46ff8cp-2f,

@@ -15,11 +15,12 @@
 //   no gravity, dt 1/480 s, 8 velocity / 3 position iterations, random orientation at a fixed height, until separated;
 //   1247 trials had not separated 3 s after first contact (time limit; their final velocities are used)
 // rest poses (paper 3.2.3): 2000 drops with gravity 9.81 m/s^2, dt 1/120 s, until Box2D put the body to sleep; 0 were still awake after 30 s;
-//   greedy clustering of body-frame up vectors at 10 degrees, snapped to hull faces within 3 degrees; kept: frequency > 0.05; h_rest on the core shape
-//   pose 0: up (1.000000, 0.000000) h_rest 0.500000 m, 525 drops, frequency 0.2625
-//   pose 1: up (-1.000000, 0.000000) h_rest 0.500000 m, 512 drops, frequency 0.2560
-//   pose 2: up (0.000000, 1.000000) h_rest 0.500000 m, 482 drops, frequency 0.2410
-//   pose 3: up (0.000000, -1.000000) h_rest 0.500000 m, 481 drops, frequency 0.2405
+//   greedy clustering of body-frame up vectors at 10 degrees, snapped to hull faces within 3 degrees; kept: families (poses equivalent under the shape's symmetry) of frequency > 0.05, then rarer ones while more than 0.02 of the settled drops is dropped; h_rest on the core shape
+//   pose 0: up (1.000000, 0.000000) h_rest 0.500000 m, 525 drops, frequency 0.2625, family 0
+//   pose 1: up (-1.000000, 0.000000) h_rest 0.500000 m, 512 drops, frequency 0.2560, family 0
+//   pose 2: up (0.000000, 1.000000) h_rest 0.500000 m, 482 drops, frequency 0.2410, family 0
+//   pose 3: up (0.000000, -1.000000) h_rest 0.500000 m, 481 drops, frequency 0.2405, family 0
+//   dropped: 0.0000 of the settled drops
 #pragma once
 
 #include "statsim/signature.hpp"
@@ -28,7 +29,8 @@ static_assert(STATSIM_TABLE_FORMAT_VERSION == 2, "tables/square2d.hpp was genera
 
 namespace statsim::tables {
 
-// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses>
+// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,
+//           spread values per cell (the paper's model: one standard deviation per component)>
 inline constexpr Signature<2, 16, 7, 9, 5, 1, 4, 3> square2d = {
     "square2d",
     0x1.6a09e6p-1f,  // length L (bounding radius), m
@@ -237,7 +239,7 @@ inline constexpr Signature<2, 16, 7, 9, 5, 1, 4, 3> square2d = {
         0x1.92d08cp+0f, -0x1.b55a02p-1f, 0x1.a6c9bp-1f, 0x1.707c8ep+0f, -0x1.a5748p-1f, 0x1.c4955ap-1f,
         0x1.6e0fbp+0f, -0x1.adaf52p-1f, 0x1.c2c5e2p-1f
     }},
-    // response_stddev
+    // response_spread: per cell the standard deviation of each component
     {{
         0x1.11c71cp-1f, 0x1.b334b8p-4f, 0x1.b3090cp-3f, 0x1.8bb0e6p-1f, 0x1.51d842p-3f, 0x1.51c2b6p-2f,
         0x1.569026p-1f, 0x1.1d9338p-3f, 0x1.1d7f7ep-2f, 0x1.54757ap-1f, 0x1.2366fap-3f, 0x1.235958p-2f,

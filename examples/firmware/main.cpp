@@ -1,5 +1,6 @@
 // Firmware example: a 3D world of boxes (or L-shapes, or bunnies) and a 2D world of squares from
-// the committed tables, each stepped FIRMWARE_STEPS times, then one line per world with the step
+// the committed tables, and a small 3D world of the other response models, each stepped
+// FIRMWARE_STEPS times, then one line per world with the step
 // count and the FNV-1a hash of its whole state (`state_hash()`: positions, orientations,
 // velocities, sleep states, random streams). The same file builds for the host (firmware_host)
 // and, with startup.cpp and mps2-an386.ld, for a Cortex-M4F under QEMU (see CMakeLists.txt here);
@@ -20,6 +21,7 @@
 #include <statsim/world2.hpp>
 #include <statsim/world3.hpp>
 #include <tables/square2d.hpp>
+#include <tools/scenes/synthetic_signatures.hpp>
 
 #ifndef FIRMWARE_BODIES
 #define FIRMWARE_BODIES 64
@@ -93,12 +95,19 @@ constexpr std::uint32_t columns2 = grid_side(bodies, 8, 8, 1);
 // Quantised at compile time: only the 16-bit tables are in the image.
 constexpr auto table3 = statsim::quantize16(FIRMWARE_TABLE);
 constexpr auto table2 = statsim::quantize16(statsim::tables::square2d);
+constexpr auto correlated = statsim::quantize16(statsim::testing::cube_correlated_synthetic);
+constexpr auto empirical = statsim::quantize16(statsim::testing::cube_empirical_synthetic);
 constexpr const char* precision = "i16";
 #else
 constexpr const auto& table3 = FIRMWARE_TABLE;
 constexpr const auto& table2 = statsim::tables::square2d;
+constexpr const auto& correlated = statsim::testing::cube_correlated_synthetic;
+constexpr const auto& empirical = statsim::testing::cube_empirical_synthetic;
 constexpr const char* precision = "f32";
 #endif
+// The committed tables hold the default response model; a small third world steps the others
+// (hand-made cubes, tools/scenes/synthetic_signatures.hpp) so that every model is compared.
+constexpr std::uint32_t model_bodies = 16;
 
 // ---- output without printf (newlib's printf allocates) -------------------------------------------
 class Line {
@@ -147,6 +156,7 @@ void on_assert(const char* expression, const char* file, int line)
 // The worlds live in static storage: constructed by the start-up code before main, no heap.
 statsim::World3<bodies, 8, pairs3, 2> world3;
 statsim::World2<bodies, 8, pairs2, 2> world2;
+statsim::World3<model_bodies, 1, 4 * model_bodies, 2> world_models;
 
 /// A unit quaternion from four uniform draws (normalising a random 4-vector; no trigonometry).
 statsim::Quaternion random_orientation(statsim::Pcg32& rng)
@@ -219,6 +229,25 @@ bool build_world2()
   return true;
 }
 
+bool build_world_models()
+{
+  const auto a = world_models.add_shape(correlated.view());
+  const auto b = world_models.add_shape(empirical.view());
+  if (!a.ok() || !b.ok() || !world_models.add_plane(statsim::Vector3(0, 0, 1), 0).ok()) return false;
+  statsim::Pcg32 rng(7, 4);
+  for (std::uint32_t i = 0; i < model_bodies; ++i) {
+    statsim::BodyDef3 def;
+    def.shape = i % 2 ? b.id : a.id;
+    def.position = statsim::Vector3(0.3f * float(i % 4), 0.3f * float(i / 4), 0.3f + 0.1f * float(i % 3));
+    def.orientation = random_orientation(rng);
+    const float wx = rng.uniform(-5, 5);
+    const float wy = rng.uniform(-5, 5);
+    def.angular_velocity = statsim::Vector3(wx, wy, 0);
+    if (!world_models.add_body(def).ok()) return false;
+  }
+  return true;
+}
+
 /// Steps a world and prints its line; returns false if a step failed or dropped pairs.
 template <class World>
 bool run(World& world, const char* label, const char* table)
@@ -272,14 +301,15 @@ bool run(World& world, const char* label, const char* table)
 int main()
 {
   statsim::set_assert_handler(&on_assert);
-  if (!build_world3() || !build_world2()) {
+  if (!build_world3() || !build_world2() || !build_world_models()) {
     Line().text("firmware: could not build the worlds").emit();
     return 1;
   }
   const bool ok3 = run(world3, "world3", table3.name);
   const bool ok2 = run(world2, "world2", table2.name);
+  const bool ok_models = run(world_models, "models", "cube_correlated_and_empirical");
 #ifdef STATSIM_FIRMWARE
   Line().text("firmware: stack used ").dec(platform::stack_used()).text(" of ").dec(platform::stack_size()).text(" bytes").emit();
 #endif
-  return ok3 && ok2 ? 0 : 1;
+  return ok3 && ok2 && ok_models ? 0 : 1;
 }

@@ -2,6 +2,7 @@
 #include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
+#include "ref3d/cell_report.hpp"
 #include "ref3d/gather.hpp"
 #include "ref3d/sizing.hpp"
 
@@ -14,6 +15,8 @@
 #include <memory>
 #include <ostream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace statsim::tools {
 
@@ -42,6 +45,8 @@ struct GatherCommand {
   std::string mesh_shape = "gimpact";
   std::string out;
   std::string json;
+  std::string cell_report;  ///< markdown file; its JSON beside it (.json)
+  std::vector<std::string> model_json;  ///< MODEL=FILE: the same gathering's JSON with another model
   bool quiet = false;
   bool speed_check = false;
   bool step_check = false;
@@ -181,12 +186,36 @@ void run(const GatherCommand& c, const CLI::App& sub)
     };
     ensure_writable_directory(parent(c.out));
     if (!c.json.empty()) ensure_writable_directory(parent(c.json));
+    std::vector<std::pair<ResponseModel, std::string>> model_json;
+    for (const std::string& mj : c.model_json) {
+      const std::size_t eq = mj.find('=');
+      if (eq == std::string::npos || eq + 1 == mj.size())
+        throw std::runtime_error("--model-json takes MODEL=FILE, not '" + mj + "'");
+      GatherOptions other = o;
+      other.response_model = parse_response_model(mj.substr(0, eq));
+      validate_gather_options(other);
+      model_json.emplace_back(other.response_model, mj.substr(eq + 1));
+      ensure_writable_directory(parent(model_json.back().second));
+    }
     const std::string command = recorded_command(sub);
     GatherResult r;
     if (c.size_for_scene) r = gather_sized(c, o, out);
     else r = gather(o);
     const std::string header = header_text(r, command);
     if (!c.json.empty()) write_file_atomic(c.json, json_text(r, command));
+    if (!c.cell_report.empty()) {
+      const CellReport report = cell_report(r);
+      write_file_atomic(c.cell_report, cell_report_text(r, report));
+      write_file_atomic(std::filesystem::path(c.cell_report).replace_extension(".json").string(),
+                        cell_report_json(report));
+    }
+    for (const auto& [model, file] : model_json) {
+      // The same trials reduced by another model: what a gathering with that model would write.
+      GatherResult other = r;
+      other.options.response_model = model;
+      write_file_atomic(file, json_text(other, command + " (JSON of --response-model " +
+                                                   response_model_name(model) + ")"));
+    }
     try {
       write_file_atomic(c.out, header);
     } catch (...) {
@@ -259,6 +288,12 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
       ->capture_default_str();
   sub->add_option("--out", c->out, "Output header (tables/NAME.hpp); with a check, the report");
   sub->add_option("--json", c->json, "Also dump the signature as JSON to this file");
+  sub->add_option("--cell-report", c->cell_report,
+                  "Also write how far the paper's model is from the trials, per cell (markdown FILE.md and FILE.json: "
+                  "KS from the fitted Gaussian, correlations, bimodality)");
+  sub->add_option("--model-json", c->model_json,
+                  "MODEL=FILE: also write the JSON of the same gathering with response model MODEL (repeatable; "
+                  "for comparing models on the same trials)");
   sub->add_option("--threads", o.threads, "Worker threads (0 = all hardware threads)")->capture_default_str();
   sub->add_option("--name", o.name, "Table name (default: the shape's name)");
   sub->add_option("--speed", o.speed, "|V-| of the impacts of the scaled layout, m/s")->capture_default_str();
