@@ -150,11 +150,13 @@ void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D
 
 /// The shared loop over plane contacts: for every awake body and plane that touch (spheres grown
 /// by `contact_slop` when `grown`), moves the body out of the plane, marks it touching (and on
-/// the ground for a near-horizontal plane), then calls `respond(body, contact, ground)`.
+/// the ground for a near-horizontal plane), then calls `respond(body, contact, ground)`; on a
+/// tilted plane it then takes the downhill move back that the response's friction cancelled.
 /// Returns the number of contacts.
 template <int D, class Respond>
 std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Respond&& respond)
 {
+  using Vec = typename Space<D>::Vec;
   std::uint32_t contacts = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     Body<D>& b = w.bodies[i];
@@ -173,7 +175,28 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       const bool ground = c.normal[Space<D>::up_axis] >= w.def.ground_cosine;
       b.on_ground = b.on_ground || ground;
       ++contacts;
+      // The step has already moved the body by its velocity with this step's gravity in it. On a
+      // tilted plane the friction that holds a resting body takes gravity's pull along the plane,
+      // g_t dt, out of its velocity but not out of that move, so it would creep downhill by
+      // g_t dt^2 every step however firmly it is held (g sin(a) per second of creep speed). The
+      // same part is taken out of the move: what the response removed of the downhill velocity,
+      // at most g_t dt, times dt. Planes that carry no weight (n.g >= 0, walls) and level ones
+      // (g_t = 0 exactly) are left alone.
+      const Vec& g = w.def.gravity;
+      const Scalar gn = g.dot(c.normal);
+      const Vec gt = g - c.normal * gn;
+      const Scalar gt2 = gt.squaredNorm();
+      if (!(gn < 0) || !(gt2 > 0)) {
+        respond(b, c, ground);
+        continue;
+      }
+      const Scalar pull = std::sqrt(gt2);
+      const Vec downhill = gt / pull;
+      const Scalar before = b.linear_velocity.dot(downhill);
       respond(b, c, ground);
+      const Scalar taken = before - b.linear_velocity.dot(downhill);
+      const Scalar held = pull * ctx.dt;
+      if (taken > 0) b.position -= downhill * ((taken < held ? taken : held) * ctx.dt);
     }
   }
   return contacts;
