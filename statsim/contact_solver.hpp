@@ -157,6 +157,17 @@ template <int D, class Respond>
 std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Respond&& respond)
 {
   using Vec = typename Space<D>::Vec;
+  const Vec& g = w.def.gravity;
+  // Tilted: a plane that carries weight (n.g < 0) with gravity pulling along it (see below).
+  const auto tilted = [&g](const Vec& n, Scalar& gn) {
+    gn = g.dot(n);
+    return gn < 0 && (g - n * gn).squaredNorm() > 0;
+  };
+  bool any_tilted = false;
+  for (std::uint32_t p = 0; p < w.plane_count; ++p) {
+    Scalar gn;
+    any_tilted = any_tilted || tilted(w.planes[p].normal, gn);
+  }
   std::uint32_t contacts = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     Body<D>& b = w.bodies[i];
@@ -182,15 +193,13 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       // same part is taken out of the move: what the response removed of the downhill velocity,
       // at most g_t dt, times dt. Planes that carry no weight (n.g >= 0, walls) and level ones
       // (g_t = 0 exactly) are left alone.
-      const Vec& g = w.def.gravity;
-      const Scalar gn = g.dot(c.normal);
-      const Vec gt = g - c.normal * gn;
-      const Scalar gt2 = gt.squaredNorm();
-      if (!(gn < 0) || !(gt2 > 0)) {
+      Scalar gn;
+      if (!any_tilted || !tilted(c.normal, gn)) {
         respond(b, c, ground);
         continue;
       }
-      const Scalar pull = std::sqrt(gt2);
+      const Vec gt = g - c.normal * gn;
+      const Scalar pull = gt.norm();
       const Vec downhill = gt / pull;
       const Scalar before = b.linear_velocity.dot(downhill);
       respond(b, c, ground);

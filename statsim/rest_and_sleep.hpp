@@ -128,7 +128,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const Scalar w2 = turning ? Scalar(0) : squared_norm(b.angular_velocity) * r2;
     const Scalar speed2 = v2 > w2 ? v2 : w2;
     const bool settling = b.touching && speed2 < settle2;
-    const Vec ground = b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
+    const Vec ground = settling && b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
     update_rest_pose(w, b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt, ground);
     if (!settling) {
       b.state = MotionState::moving;
