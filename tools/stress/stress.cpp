@@ -1229,7 +1229,7 @@ void register_stress_commands(CLI::App& app)
                   "slopes")
       ->delimiter(',');
   cmd->add_option("--json", *json, "Write the cells as JSON to FILE");
-  cmd->add_flag("--quick", opts->quick, "Smaller scenes: 1,000-bunny pile, 2,000 energy steps, 120 s long run");
+  cmd->add_flag("--quick", opts->quick, "Smaller scenes: 1,000-bunny pile, 2,000 energy steps, 120 s long run, 36 bunnies per slope");
   cmd->add_option("--budget", opts->budget_s, "Wall-clock seconds one Bullet cell of the pile or energy scene may take")
       ->capture_default_str();
   cmd->add_option("--meshes", opts->meshes_dir, "Directory of bunny.obj, bunny_low.obj, bunny_spheres7.txt");
