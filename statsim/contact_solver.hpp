@@ -58,11 +58,12 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
   // keep a body from ever settling. It gets the inelastic particle response instead.
   const bool resting = -v.dot(n) <= def.restitution_threshold;
   if (shape.statistical && tilted_plane && resting && !(ground_contact && b.rest_pose != no_rest_pose)) {
-    // Rolling resistance on a point without lever arm brakes its sliding as extra friction
-    // (mu + c instead of mu: on 35 degrees g (sin a - 0.55 cos a) instead of g (sin a - 0.5 cos a)).
-    // On a tilted plane it slows the spin alone, and the velocity only where it stops it (what
-    // is left of the slip once friction held the body); the normal impulse is -v.n, as nothing
-    // bounces at a resting contact.
+    // Rolling resistance taken off the velocity of a point without lever arm brakes its sliding
+    // as extra friction: a slide down the plane at g (sin a - (mu + c) cos a) instead of
+    // g (sin a - mu cos a), and sliding only from tan a > mu + c. On a tilted plane it slows the
+    // spin alone, and the velocity only where it stops it (what is left of the slip once
+    // friction held the body); the normal impulse is -v.n, as nothing bounces at a resting
+    // contact.
     Material slide = shape.material;
     slide.rolling_resistance = 0;
     const Scalar jn = -v.dot(n);
@@ -213,7 +214,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       // The step has already moved the body by its velocity with this step's gravity in it. On a
       // tilted plane the friction that holds a resting body takes gravity's pull along the plane,
       // g_t dt, out of its velocity but not out of that move, so it would creep downhill by
-      // g_t dt^2 every step however firmly it is held (g sin(a) per second of creep speed). The
+      // g_t dt^2 every step however firmly it is held (at g sin(a) dt, metres per second). The
       // same part is taken out of the move: what the response removed of the downhill velocity,
       // at most g_t dt, times dt. Planes that carry no weight (n.g >= 0, walls) and level ones
       // (g_t = 0 exactly) are left alone.
