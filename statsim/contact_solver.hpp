@@ -44,9 +44,10 @@ constexpr Scalar contact_slop = Scalar(1e-3);
 /// shapes (paper 3.3.2; for body-body contacts each body responds on its own, as in the
 /// paper), the rest turn for bodies settling on the ground (paper 3.4), else (plain spheres,
 /// and resting contacts of statistical bodies) the particle response against a static plane.
+/// `tilted_plane`: the contact is with a plane that gravity pulls the body along.
 template <int D>
 void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const typename Space<D>::Vec& n,
-                   const typename Space<D>::Vec& other_velocity, bool ground_contact)
+                   const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& shape = w.shapes[b.shape];
@@ -62,7 +63,30 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
       shape.statistical && def.table_restitution_threshold && b.state != MotionState::settling;
   const Scalar threshold = table_threshold ? shape.signature.restitution_threshold : def.restitution_threshold;
   const bool resting = -v.dot(n) <= threshold;
-  if (!shape.statistical || (resting && !(ground_contact && b.rest_pose != no_rest_pose))) {
+  if (shape.statistical && tilted_plane && resting && !(ground_contact && b.rest_pose != no_rest_pose)) {
+    // Rolling resistance taken off the velocity of a point without lever arm brakes its sliding
+    // as extra friction: a slide down the plane at g (sin a - (mu + c) cos a) instead of
+    // g (sin a - mu cos a), and sliding only from tan a > mu + c. On a tilted plane it slows the
+    // spin alone, and the velocity only where it stops it (what is left of the slip once
+    // friction held the body); the normal impulse is -v.n, as nothing bounces at a resting
+    // contact.
+    Material slide = shape.material;
+    slide.rolling_resistance = 0;
+    const Scalar jn = -v.dot(n);
+    if (!particle_plane_response<D>(v, b.angular_velocity, Scalar(0), n, slide, def.restitution_threshold)) return;
+    const Scalar c = shape.material.rolling_resistance;
+    if (c > 0) {
+      const Vec vt = v - n * v.dot(n);
+      const Scalar speed = vt.norm();
+      const Scalar cut = c * jn;
+      if (speed > cut) {
+        b.angular_velocity = b.angular_velocity * (1 - cut / speed);
+      } else {
+        v -= vt;
+        b.angular_velocity = Space<D>::zero_spin();
+      }
+    }
+  } else if (!shape.statistical || (resting && !(ground_contact && b.rest_pose != no_rest_pose))) {
     particle_plane_response<D>(v, b.angular_velocity, contact_radius(w, b), n, shape.material,
                                def.restitution_threshold);
   } else if (ground_contact && b.rest_pose != no_rest_pose) {
@@ -156,11 +180,25 @@ void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D
 
 /// The shared loop over plane contacts: for every awake body and plane that touch (spheres grown
 /// by `contact_slop` when `grown`), moves the body out of the plane, marks it touching (and on
-/// the ground for a near-horizontal plane), then calls `respond(body, contact, ground)`.
+/// the ground for a near-horizontal plane), then calls `respond(body, contact, ground, tilted)`
+/// (tilted: gravity pulls the body along the plane); on a tilted plane it then takes the
+/// downhill move back that the response's friction cancelled.
 /// Returns the number of contacts.
 template <int D, class Respond>
 std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Respond&& respond)
 {
+  using Vec = typename Space<D>::Vec;
+  const Vec& g = w.def.gravity;
+  // Tilted: a plane that carries weight (n.g < 0) with gravity pulling along it (see below).
+  const auto tilted = [&g](const Vec& n, Scalar& gn) {
+    gn = g.dot(n);
+    return gn < 0 && (g - n * gn).squaredNorm() > 0;
+  };
+  bool any_tilted = false;
+  for (std::uint32_t p = 0; p < w.plane_count; ++p) {
+    Scalar gn;
+    any_tilted = any_tilted || tilted(w.planes[p].normal, gn);
+  }
   std::uint32_t contacts = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     Body<D>& b = w.bodies[i];
@@ -179,7 +217,26 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       const bool ground = c.normal[Space<D>::up_axis] >= w.def.ground_cosine;
       b.on_ground = b.on_ground || ground;
       ++contacts;
-      respond(b, c, ground);
+      // The step has already moved the body by its velocity with this step's gravity in it. On a
+      // tilted plane the friction that holds a resting body takes gravity's pull along the plane,
+      // g_t dt, out of its velocity but not out of that move, so it would creep downhill by
+      // g_t dt^2 every step however firmly it is held (at g sin(a) dt, metres per second). The
+      // same part is taken out of the move: what the response removed of the downhill velocity,
+      // at most g_t dt, times dt. Planes that carry no weight (n.g >= 0, walls) and level ones
+      // (g_t = 0 exactly) are left alone.
+      Scalar gn;
+      if (!any_tilted || !tilted(c.normal, gn)) {
+        respond(b, c, ground, false);
+        continue;
+      }
+      const Vec gt = g - c.normal * gn;
+      const Scalar pull = gt.norm();
+      const Vec downhill = gt / pull;
+      const Scalar before = b.linear_velocity.dot(downhill);
+      respond(b, c, ground, true);
+      const Scalar taken = before - b.linear_velocity.dot(downhill);
+      const Scalar held = pull * ctx.dt;
+      if (taken > 0) b.position -= downhill * ((taken < held ? taken : held) * ctx.dt);
     }
   }
   return contacts;
@@ -223,7 +280,7 @@ void forget_contacts(WorldData<D>& w)
 template <int D>
 void support_planes(WorldData<D>& w, StepContext& ctx)
 {
-  plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool) {
+  plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool) {
     if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
                                    w.shapes[b.shape].material, no_bounce))
       ++ctx.changes;
@@ -238,8 +295,9 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
 {
   using Vec = typename Space<D>::Vec;
   const WorldDef<D>& def = w.def;
-  const std::uint32_t plane_count = plane_contacts(w, ctx, false, [&](Body<D>& b, const Contact<D>& c, bool ground) {
-    if (w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground);
+  const std::uint32_t plane_count = plane_contacts(w, ctx, false, [&](Body<D>& b, const Contact<D>& c, bool ground,
+                                                                      bool tilted) {
+    if (w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground, tilted);
     else if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
                                         w.shapes[b.shape].material, def.restitution_threshold))
       ++ctx.changes;
@@ -336,7 +394,7 @@ std::uint32_t position_pass(WorldData<D>& w, StepContext& ctx)
     correct_overlap(w, ctx, a, b, c, slop, ima, imb, ims);
     return true;
   });
-  plane_contacts(w, ctx, true, [](Body<D>&, const Contact<D>&, bool) {});
+  plane_contacts(w, ctx, true, [](Body<D>&, const Contact<D>&, bool, bool) {});
   return ctx.moves;
 }
 

@@ -7,9 +7,32 @@
 #include "statsim/world_data.hpp"
 
 #include <cstdint>
+#include <limits>
 
 namespace statsim {
 namespace detail {
+
+/// The normal of the ground plane (normal within `ground_cosine` of up) nearest to the body's
+/// sphere, or up when there is none: rest poses, their turn and their height are taken against
+/// the plane a body rests on, which on a slope is not level.
+template <int D>
+typename Space<D>::Vec ground_normal(const WorldData<D>& w, const Body<D>& b)
+{
+  using Vec = typename Space<D>::Vec;
+  const int up = Space<D>::up_axis;
+  Vec normal = Vec::Unit(up);
+  Scalar nearest = std::numeric_limits<Scalar>::infinity();
+  for (std::uint32_t p = 0; p < w.plane_count; ++p) {
+    const Plane<D>& plane = w.planes[p];
+    if (!(plane.normal[up] >= w.def.ground_cosine)) continue;
+    const Scalar gap = plane.normal.dot(b.position) - plane.offset - b.radius;
+    if (gap < nearest) {
+      nearest = gap;
+      normal = plane.normal;
+    }
+  }
+  return normal;
+}
 
 /// Collision radius of statistical bodies (paper 3.3.1), blended toward the rest height of a
 /// chosen rest pose (paper 3.4).
@@ -35,29 +58,29 @@ void update_radii(WorldData<D>& w)
     const Scalar h = b.rest_pose != no_rest_pose ? sig.rest.heights[b.rest_pose] : shape.mean_rest_height;
     const Scalar blended = r + (h - r) * b.rest_blend;
     // A settling body's sphere changes size about its lowest point, so a body blending to its
-    // rest height settles smoothly instead of dropping (paper 3.4).
-    if (b.on_ground || b.pile_rest) b.position[Space<D>::up_axis] += blended - b.radius;
+    // rest height settles smoothly instead of dropping (paper 3.4); on the ground that point is
+    // below the centre along the plane's normal.
+    if (b.on_ground) b.position += ground_normal(w, b) * (blended - b.radius);
+    else if (b.pile_rest) b.position[Space<D>::up_axis] += blended - b.radius;
     b.radius = blended;
   }
 }
 
 /// Resting conditions (paper 3.4): a statistical body settling on the ground picks the rest
-/// pose nearest to its orientation and blends its radius toward that pose's height; a body
-/// that speeds up again blends back and forgets the pose; a body briefly off the ground keeps
-/// it.
+/// pose nearest to its orientation relative to the ground's normal `ground` and blends its
+/// radius toward that pose's height; a body that speeds up again blends back and forgets the
+/// pose; a body briefly off the ground keeps it.
 template <int D>
 void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground, bool settling_on_bodies, bool fast,
-                      Scalar dt)
+                      Scalar dt, const typename Space<D>::Vec& ground)
 {
-  using Vec = typename Space<D>::Vec;
   const Shape<D>& shape = w.shapes[b.shape];
   const WorldDef<D>& def = w.def;
   if (!shape.statistical || !def.rest_conditions || shape.signature.rest.count == 0) return;
   const Scalar step = dt / def.rest_blend_time;
   if (settling_on_ground) {
     if (b.rest_pose == no_rest_pose) {
-      const std::uint32_t pose =
-          nearest_rest_pose<D>(shape.signature, b.orientation, Vec::Unit(Space<D>::up_axis), shape.rest_bias.data());
+      const std::uint32_t pose = nearest_rest_pose<D>(shape.signature, b.orientation, ground, shape.rest_bias.data());
       if (pose >= shape.signature.rest.count) return;  // only with a non-finite orientation
       b.rest_pose = std::uint8_t(pose);
     }
@@ -75,13 +98,13 @@ void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground
   }
 }
 
-/// True when the chosen rest pose's normal is within `rest_snap_cosine` of up.
+/// True when the chosen rest pose's normal is within `rest_snap_cosine` of the ground's normal.
 template <int D>
-bool in_rest_pose(const WorldData<D>& w, const Body<D>& b)
+bool in_rest_pose(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& ground)
 {
   const SignatureView<D>& sig = w.shapes[b.shape].signature;
   const typename Space<D>::Vec u = b.orientation * sig.rest.normal(b.rest_pose);
-  return u[Space<D>::up_axis] >= w.def.rest_snap_cosine;
+  return u.dot(ground) >= w.def.rest_snap_cosine;
 }
 
 /// The last phase of a step: each awake body is moving, settling (touching and slower than
@@ -105,7 +128,8 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const Scalar w2 = turning ? Scalar(0) : squared_norm(b.angular_velocity) * r2;
     const Scalar speed2 = v2 > w2 ? v2 : w2;
     const bool settling = b.touching && speed2 < settle2;
-    update_rest_pose(w, b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt);
+    const Vec ground = settling && b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
+    update_rest_pose(w, b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt, ground);
     if (!settling) {
       b.state = MotionState::moving;
       b.slow_time = 0;
@@ -120,7 +144,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const Scalar lin2 = moved2 < v2 * dt * dt ? moved2 / (dt * dt) : v2;
     // It turns at ground contacts only: one that keeps its pose while held up by other bodies
     // cannot reach it there, and may sleep where it is.
-    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (!turning || !b.on_ground || in_rest_pose(w, b));
+    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (!turning || !b.on_ground || in_rest_pose(w, b, ground));
     b.slow_time = still ? b.slow_time + dt : 0;
     if (still && b.slow_time >= def.sleep_time) {
       b.state = MotionState::asleep;
@@ -130,10 +154,9 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
         // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
         // the radius blend are below what a slow body would show.
         const SignatureView<D>& sig = w.shapes[b.shape].signature;
-        const Vec up = Vec::Unit(Space<D>::up_axis);
-        b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), up);
+        b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
         const Scalar h = sig.rest.heights[b.rest_pose];
-        b.position[Space<D>::up_axis] += h - b.radius;
+        b.position += ground * (h - b.radius);
         b.radius = h;
         b.rest_blend = 1;
       }

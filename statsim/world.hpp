@@ -190,6 +190,7 @@ class WorldCore {
       return result;
     }
     detail::StepContext ctx;
+    ctx.dt = dt;
     detail::integrate(w_, dt);
     detail::update_radii(w_);
     detail::find_pairs(w_, result);

@@ -163,7 +163,7 @@ struct WorldDef {
   /// farthest point moves at most at `settle_speed`. Seconds, >= 1e-4.
   Scalar rest_turn_time = Scalar(0.1);
   /// A body turning into its rest pose may fall asleep (and snap into the pose) once the pose's
-  /// normal is within this cosine of up (0.996: about 5 degrees).
+  /// normal is within this cosine of the ground plane's normal (0.996: about 5 degrees).
   Scalar rest_snap_cosine = Scalar(0.996);
   /// A plane counts as ground for resting conditions when its normal's up component is at least
   /// this (0.9: within about 25 degrees of horizontal).

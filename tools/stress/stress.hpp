@@ -1,6 +1,6 @@
 // `statsim stress`: the stress matrix, scenes where approximate methods fail (fast
 // impacts, large time steps, a deep pile, energy in a closed elastic box, states beyond the
-// table's range, a long run, bad input through the public API) against every method: Bullet's
+// table's range, a long run, bad input through the public API, rest and sliding on slopes) against every method: Bullet's
 // reference representations (full, low, spheres7, sphere) and statsim (statistical) in 3D; Box2D
 // (polygon) and statsim (statistical2d) in 2D where the scene applies. Each cell prints pass or
 // fail, its figure and its pass criterion; --json writes the cells.
@@ -13,6 +13,9 @@ namespace statsim::tools {
 
 struct StressOptions {
   std::vector<std::string> methods;  ///< empty: all
+  /// Scenes to run (bad-input, fast-impact, large-dt, out-of-range, energy, deep-pile, long-run,
+  /// slopes); empty: all.
+  std::vector<std::string> scenes;
   bool quick = false;                ///< smaller scenes and budgets (about a minute)
   double budget_s = 60.0;            ///< wall-clock budget of one reference-engine cell
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes

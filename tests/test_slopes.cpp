@@ -1,0 +1,133 @@
+// Statistical bodies on tilted planes: with friction above the slope's tangent they come to rest
+// where they land and fall asleep in a rest pose against the plane; below it they keep sliding.
+#include <doctest/doctest.h>
+
+#include "statsim/world2.hpp"
+#include "statsim/world3.hpp"
+#include "tables/bunny.hpp"
+#include "tables/square2d.hpp"
+
+#include <cmath>
+#include <memory>
+
+using namespace statsim;
+
+namespace {
+constexpr float kPi = 3.14159265f;
+constexpr float kDt = 1.0f / 60;
+constexpr int kBodies = 8;
+
+/// A world of bodies dropped from rest, 0.4 m above a plane through the origin that falls along
+/// +y at `degrees` (3D) or along +x (2D), spaced along the other horizontal axis (3D) or along the
+/// slope (2D) so that they never touch each other.
+template <int D>
+struct Slope {
+  using Vec = typename Space<D>::Vec;
+  std::unique_ptr<World<D, kBodies>> w = std::make_unique<World<D, kBodies>>();
+  Vec normal, downhill;
+
+  Slope(const SignatureView<D>& sig, float degrees)
+  {
+    const float a = degrees * kPi / 180;
+    const ShapeId shape = w->add_shape(sig).id;
+    Pcg32 g(7, 1);
+    if constexpr (D == 3) {
+      normal = Vector3(0, std::sin(a), std::cos(a));
+      downhill = Vector3(0, std::cos(a), -std::sin(a));
+    } else {
+      normal = Vector2(std::sin(a), std::cos(a));
+      downhill = Vector2(std::cos(a), -std::sin(a));
+    }
+    REQUIRE(w->add_plane(normal, 0).ok());
+    for (int i = 0; i < kBodies; ++i) {
+      BodyDef<D> b;
+      b.shape = shape;
+      b.mass = sig.mass;
+      if constexpr (D == 3) {
+        b.position = Vector3(float(i), 0, 0.4f + sig.bounding_radius);
+        const Vector3 axis = Vector3(g.uniform(-1, 1), g.uniform(-1, 1), g.uniform(-1, 1)).normalized();
+        b.orientation = Quaternion(Eigen::AngleAxisf(g.uniform(-kPi, kPi), axis));
+      } else {
+        // Along the slope, 3 m apart, each 0.4 m above it (vertically).
+        const Vector2 on = downhill * (3.0f * float(i));
+        b.position = Vector2(on.x(), on.y() + 0.4f + sig.bounding_radius / std::cos(a));
+        b.orientation = Rot2::from_angle(g.uniform(-kPi, kPi));
+      }
+      REQUIRE(w->add_body(b).ok());
+    }
+  }
+  void run(float seconds)
+  {
+    const int steps = int(std::lround(seconds / kDt));
+    for (int k = 0; k < steps; ++k) REQUIRE(w->step(kDt).ok());
+  }
+  float along(std::uint32_t i) const { return w->body(i).position.dot(downhill); }
+};
+
+template <int D>
+void rests_on_gentle_slope(const SignatureView<D>& sig)
+{
+  Slope<D> s(sig, 10);
+  // Falling 0.4 m takes 0.29 s; a few seconds later every body sleeps.
+  s.run(4);
+  CHECK(s.w->count(MotionState::asleep) == kBodies);
+  float at_rest[kBodies];
+  for (std::uint32_t i = 0; i < kBodies; ++i) {
+    CAPTURE(i);
+    at_rest[i] = s.along(i);
+    const auto& b = s.w->body(i);
+    REQUIRE(b.rest_pose < sig.rest.count);
+    // In its rest pose against the plane, not against world up, at the pose's height.
+    CHECK((b.orientation * sig.rest.normal(b.rest_pose)).dot(s.normal) > std::cos(1.0f * kPi / 180));
+    CHECK(b.position.dot(s.normal) == doctest::Approx(sig.rest.heights[b.rest_pose]).epsilon(1e-4));
+  }
+  s.run(10);
+  CHECK(s.w->count(MotionState::asleep) == kBodies);
+  for (std::uint32_t i = 0; i < kBodies; ++i) CHECK(s.along(i) == at_rest[i]);
+}
+
+template <int D>
+void slides_on_steep_slope(const SignatureView<D>& sig)
+{
+  // tan 35 deg = 0.70 > friction 0.5: sliding accelerates at g (sin a - mu cos a) = 1.6 m/s^2.
+  Slope<D> s(sig, 35);
+  s.run(3);
+  float at3[kBodies], v3[kBodies];
+  for (std::uint32_t i = 0; i < kBodies; ++i) {
+    at3[i] = s.along(i);
+    v3[i] = s.w->body(i).linear_velocity.dot(s.downhill);
+  }
+  s.run(1);
+  CHECK(s.w->count(MotionState::asleep) == 0);
+  const float a = 35 * kPi / 180, slide = 9.81f * (std::sin(a) - 0.5f * std::cos(a));
+  for (std::uint32_t i = 0; i < kBodies; ++i) {
+    CAPTURE(i);
+    // A second later, still sliding downhill at well over a metre per second, speeding up as a
+    // block with friction 0.5 does (rolling resistance must not brake the slide).
+    CHECK(s.along(i) - at3[i] > 1.0f);
+    const float v4 = s.w->body(i).linear_velocity.dot(s.downhill);
+    CHECK(v4 > 1.0f);
+    CHECK(v4 - v3[i] == doctest::Approx(slide).epsilon(0.05));
+  }
+}
+}  // namespace
+
+TEST_CASE("slopes - bunnies on 10 degrees with friction 0.5 fall asleep in a pose against the plane and stay put")
+{
+  rests_on_gentle_slope<3>(tables::bunny.view());
+}
+
+TEST_CASE("slopes - bunnies on 35 degrees with friction 0.5 keep sliding")
+{
+  slides_on_steep_slope<3>(tables::bunny.view());
+}
+
+TEST_CASE("slopes - squares (2D) on 10 degrees fall asleep against the plane and stay put")
+{
+  rests_on_gentle_slope<2>(tables::square2d.view());
+}
+
+TEST_CASE("slopes - squares (2D) on 35 degrees keep sliding")
+{
+  slides_on_steep_slope<2>(tables::square2d.view());
+}
