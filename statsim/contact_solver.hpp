@@ -58,10 +58,16 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
   // keep a body from ever settling. It gets the inelastic particle response instead. A body
   // that is not settling bounces as the reference did when the table was gathered, down to the
   // table's threshold; a settling one approaches at |g| dt each step while it rests, so it
-  // keeps the world's.
+  // keeps the world's. The table's threshold is never taken below 2 |g.n| dt either: a body
+  // sliding or rolling on a plane meets it at |g.n| dt every step, and a sampled response there
+  // would replace the slide's friction and drain a roll's spin at every step.
   const bool table_threshold =
       shape.statistical && def.table_restitution_threshold && b.state != MotionState::settling;
-  const Scalar threshold = table_threshold ? shape.signature.restitution_threshold : def.restitution_threshold;
+  Scalar threshold = table_threshold ? shape.signature.restitution_threshold : def.restitution_threshold;
+  if (table_threshold) {
+    const Scalar gravity_step = 2 * std::fabs(def.gravity.dot(n)) * ctx.dt;
+    if (threshold < gravity_step) threshold = gravity_step;
+  }
   const bool resting = -v.dot(n) <= threshold;
   if (shape.statistical && tilted_plane && resting && !(ground_contact && b.rest_pose != no_rest_pose)) {
     // Rolling resistance taken off the velocity of a point without lever arm brakes its sliding
