@@ -398,9 +398,9 @@ TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run
       // A scale that is not the 16-bit rule's for the values would load other integers than the
       // header holds: refused.
       nlohmann::json j = nlohmann::json::parse(read_file(js));
-      j["response"]["i16"]["std_scale"] = 2 * j["response"]["i16"]["std_scale"].get<double>();
+      j["response"]["i16"]["spread_scale"] = 2 * j["response"]["i16"]["spread_scale"].get<double>();
       CHECK_THROWS_WITH_AS(parse_signature_json(j.dump(), "x.json"),
-                           doctest::Contains("x.json: the i16 scale and offset of the std table"), std::runtime_error);
+                           doctest::Contains("x.json: the i16 scale and offset of the spread table"), std::runtime_error);
     }
   }
 }

@@ -186,15 +186,25 @@ void run(const GatherCommand& c, const CLI::App& sub)
     };
     ensure_writable_directory(parent(c.out));
     if (!c.json.empty()) ensure_writable_directory(parent(c.json));
-    std::vector<std::pair<ResponseModel, std::string>> model_json;
+    std::vector<std::pair<GatherOptions, std::string>> model_json;
     for (const std::string& mj : c.model_json) {
       const std::size_t eq = mj.find('=');
       if (eq == std::string::npos || eq + 1 == mj.size())
         throw std::runtime_error("--model-json takes MODEL=FILE, not '" + mj + "'");
+      // MODEL[:K][:f32|:i16]: the model, the empirical outcomes a cell, the precision.
       GatherOptions other = o;
-      other.response_model = parse_response_model(mj.substr(0, eq));
+      std::stringstream spec(mj.substr(0, eq));
+      std::string part;
+      std::getline(spec, part, ':');
+      other.response_model = parse_response_model(part);
+      while (std::getline(spec, part, ':')) {
+        if (part == "i16" || part == "f32") other.i16 = part == "i16";
+        else if (!part.empty() && part.find_first_not_of("0123456789") == std::string::npos && part.size() < 4)
+          other.empirical_outcomes = std::stoi(part);
+        else throw std::runtime_error("--model-json: '" + part + "' is neither an outcome count nor f32 / i16");
+      }
       validate_gather_options(other);
-      model_json.emplace_back(other.response_model, mj.substr(eq + 1));
+      model_json.emplace_back(other, mj.substr(eq + 1));
       ensure_writable_directory(parent(model_json.back().second));
     }
     const std::string command = recorded_command(sub);
@@ -209,12 +219,14 @@ void run(const GatherCommand& c, const CLI::App& sub)
       write_file_atomic(std::filesystem::path(c.cell_report).replace_extension(".json").string(),
                         cell_report_json(report));
     }
-    for (const auto& [model, file] : model_json) {
+    for (const auto& [options, file] : model_json) {
       // The same trials reduced by another model: what a gathering with that model would write.
       GatherResult other = r;
-      other.options.response_model = model;
+      other.options.response_model = options.response_model;
+      other.options.empirical_outcomes = options.empirical_outcomes;
+      other.options.i16 = options.i16;
       write_file_atomic(file, json_text(other, command + " (JSON of --response-model " +
-                                                   response_model_name(model) + ")"));
+                                                   response_model_name(options.response_model) + ")"));
     }
     try {
       write_file_atomic(c.out, header);
@@ -292,8 +304,8 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
                   "Also write how far the paper's model is from the trials, per cell (markdown FILE.md and FILE.json: "
                   "KS from the fitted Gaussian, correlations, bimodality)");
   sub->add_option("--model-json", c->model_json,
-                  "MODEL=FILE: also write the JSON of the same gathering with response model MODEL (repeatable; "
-                  "for comparing models on the same trials)");
+                  "MODEL[:K][:f32|:i16]=FILE: also write the JSON of the same gathering with response model MODEL "
+                  "(K: its --empirical-outcomes; the precision) (repeatable; for comparing models on the same trials)");
   sub->add_option("--threads", o.threads, "Worker threads (0 = all hardware threads)")->capture_default_str();
   sub->add_option("--name", o.name, "Table name (default: the shape's name)");
   sub->add_option("--speed", o.speed, "|V-| of the impacts of the scaled layout, m/s")->capture_default_str();
