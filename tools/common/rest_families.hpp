@@ -38,9 +38,14 @@ struct RestCandidate {
 struct RestSelectionOptions {
   double min_frequency = 0.05;  ///< families above this summed frequency are kept
   double max_dropped = 1.0;     ///< then families are added while the dropped share exceeds this
-  int min_count = 1;            ///< fewest drops of a family added by the dropped-share rule
-  std::size_t max_poses = 32;   ///< most poses kept in all
-  double tolerance = 1e-3;      ///< descriptors' largest difference within a family
+  /// Fewest drops of a family added by the dropped-share rule: with fewer, a frequency is not
+  /// measured (its relative standard error is above 1/sqrt(5), about 45%).
+  int min_count = 5;
+  std::size_t max_poses = 32;   ///< most poses kept in all (statsim::max_rest_poses)
+  /// Descriptors' largest difference within a family, in units of the bounding radius: far above
+  /// the rounding of a mesh read from decimal text and of the transform to the body frame (1e-9
+  /// and below), far below any difference one could see (0.1 mm on a 0.1 m body).
+  double tolerance = 1e-3;
 };
 
 struct RestSelection {

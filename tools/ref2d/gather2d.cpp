@@ -37,11 +37,6 @@ constexpr double kGravity = 9.81;
 constexpr std::uint64_t kHeightTable = 1;
 constexpr std::uint64_t kResponseTable = 2;
 constexpr std::uint64_t kRestPoses = 3;
-// Hull edges whose descriptors differ by no more than this (in units of the bounding radius) are
-// equivalent: far above the rounding of the body-frame hull, far below any visible difference.
-constexpr double kFamilyTolerance = 1e-3;
-// Fewest drops of a family kept by the dropped-share rule (fewer do not measure a frequency).
-constexpr int kRestMinCount = 5;
 // Box2D's skins: contact is reported (and resolved) once the cores are within 2 * 0.01 m.
 constexpr double kSkin = 2.0 * static_cast<double>(b2_polygonRadius);
 
@@ -384,9 +379,6 @@ void cluster_rest_poses(Gather2dResult& r)
   RestSelectionOptions so;
   so.min_frequency = o.min_frequency;
   so.max_dropped = o.max_dropped;
-  so.min_count = kRestMinCount;
-  so.max_poses = statsim::max_rest_poses;
-  so.tolerance = kFamilyTolerance;
   const RestSelection sel = select_rest_poses(candidates, so);
   std::vector<RestCluster> sorted;
   for (std::size_t k = 0; k < order.size(); ++k) {

@@ -35,13 +35,6 @@ constexpr std::uint64_t kRestStream = 3;
 constexpr std::uint64_t kCheckStream = 5;
 // Rest normals within this angle of a hull face's are snapped to it.
 constexpr double kSnapDegrees = 3.0;
-// Hull faces whose descriptors differ by no more than this (in units of the bounding radius) are
-// equivalent: far above the rounding of a mesh read from decimal text and of the transform to
-// the body frame (1e-9 and below), far below any difference one could see (0.1 mm on a 0.1 m body).
-constexpr double kFamilyTolerance = 1e-3;
-// Fewest drops of a family kept by the dropped-share rule: with fewer, a frequency is not measured
-// (its relative standard error is above 1/sqrt(5), about 45 %).
-constexpr int kRestMinCount = 5;
 
 // A pool of Reference objects, one per worker at most: a task borrows one and gives it back.
 // Trials build a fresh Bullet world each, so which object runs a trial does not matter.
@@ -599,9 +592,6 @@ GatherResult gather(const GatherOptions& options)
     RestSelectionOptions so;
     so.min_frequency = o.rest_min_frequency;
     so.max_dropped = o.rest_max_dropped;
-    so.min_count = kRestMinCount;
-    so.max_poses = statsim::max_rest_poses;
-    so.tolerance = kFamilyTolerance;
     const RestSelection sel = select_rest_poses(candidates, so);
     for (std::size_t k = 0; k < order.size(); ++k) {
       RestPose p = poses[order[k]];
