@@ -103,7 +103,9 @@ struct WorldDef {
   /// `restitution_threshold`.
   /// Settling bodies (touching and slower than `settle_speed`) keep `restitution_threshold`: a
   /// body resting on the ground or on other bodies approaches at |g| dt every step, and a sampled
-  /// response there would keep it from ever settling. Off: every contact uses
+  /// response there would keep it from ever settling. The table's threshold is never taken below
+  /// 2 |g.n| dt (0.33 m/s on level ground at 60 Hz) either: a body sliding or rolling on a plane
+  /// meets it at |g.n| dt every step, which is not an impact. Off: every contact uses
   /// `restitution_threshold`.
   bool table_restitution_threshold = true;
   /// A touching body slower than this is settling, m/s (speed = max(|v|, |w| R_bound)).
