@@ -144,6 +144,7 @@ inline void sample_response(const ResponseTableView& table, const Scalar* x, Pcg
   switch (table.model) {
     case ResponseModel::independent_gaussian: {
       Scalar stddev[C];
+      STATSIM_ASSERT(table.spread_per_cell == n);
       table.lookup(x, mean, stddev);
       for (std::uint32_t c = 0; c < n; c += 2) {
         float g0, g1;
@@ -156,6 +157,7 @@ inline void sample_response(const ResponseTableView& table, const Scalar* x, Pcg
     case ResponseModel::correlated_gaussian: {
       // out = mean + L z, L lower triangular stored row by row: row i starts at i (i + 1) / 2.
       Scalar factor[C * (C + 1) / 2], z[C];
+      STATSIM_ASSERT(table.spread_per_cell == n * (n + 1) / 2);
       table.lookup(x, mean, factor);
       for (std::uint32_t c = 0; c < n; c += 2) {
         float g0, g1;
