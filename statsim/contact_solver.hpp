@@ -184,6 +184,26 @@ void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D
   ++ctx.moves;
 }
 
+/// True when the plane of unit normal `n` is tilted: it carries weight (n.g < 0) and gravity
+/// `g` pulls along it (a part that is not exactly zero). Writes g.n to `gn`.
+template <class Vec>
+bool is_tilted_plane(const Vec& g, const Vec& n, Scalar& gn)
+{
+  gn = g.dot(n);
+  return gn < 0 && (g - n * gn).squaredNorm() > 0;
+}
+
+/// True when some plane is tilted: only then does `plane_contacts` test each contact for one.
+/// Once per step (planes and gravity do not change within one).
+template <int D>
+bool any_tilted_plane(const WorldData<D>& w)
+{
+  Scalar gn;
+  for (std::uint32_t p = 0; p < w.plane_count; ++p)
+    if (is_tilted_plane(w.def.gravity, w.planes[p].normal, gn)) return true;
+  return false;
+}
+
 /// The shared loop over plane contacts: for every awake body and plane that touch (spheres grown
 /// by `contact_slop` when `grown`), moves the body out of the plane, marks it touching (and on
 /// the ground for a near-horizontal plane), then calls `respond(body, contact, ground, tilted)`
@@ -195,16 +215,6 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
 {
   using Vec = typename Space<D>::Vec;
   const Vec& g = w.def.gravity;
-  // Tilted: a plane that carries weight (n.g < 0) with gravity pulling along it (see below).
-  const auto tilted = [&g](const Vec& n, Scalar& gn) {
-    gn = g.dot(n);
-    return gn < 0 && (g - n * gn).squaredNorm() > 0;
-  };
-  bool any_tilted = false;
-  for (std::uint32_t p = 0; p < w.plane_count; ++p) {
-    Scalar gn;
-    any_tilted = any_tilted || tilted(w.planes[p].normal, gn);
-  }
   std::uint32_t contacts = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     Body<D>& b = w.bodies[i];
@@ -231,7 +241,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       // at most g_t dt, times dt. Planes that carry no weight (n.g >= 0, walls) and level ones
       // (g_t = 0 exactly) are left alone.
       Scalar gn;
-      if (!any_tilted || !tilted(c.normal, gn)) {
+      if (!ctx.tilted_planes || !is_tilted_plane(g, c.normal, gn)) {
         respond(b, c, ground, false);
         continue;
       }

@@ -187,7 +187,12 @@ struct ResponseTableView {
   void lookup(const Scalar* x, Scalar* mean_out, Scalar* spread_out = nullptr) const
   {
     CellWeight cw[1u << max_response_axes];
-    const std::uint32_t n = corners(x, cw);
+    interpolate(cw, corners(x, cw), mean_out, spread_out);
+  }
+
+  /// The weighted sum that `lookup` interpolates with, over `n` cells from `corners`.
+  void interpolate(const CellWeight* cw, std::uint32_t n, Scalar* mean_out, Scalar* spread_out = nullptr) const
+  {
     for (std::uint32_t c = 0; c < components; ++c) mean_out[c] = 0;
     if (spread_out)
       for (std::uint32_t c = 0; c < spread_per_cell; ++c) spread_out[c] = 0;

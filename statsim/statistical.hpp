@@ -179,7 +179,7 @@ inline void sample_response(const ResponseTableView& table, const Scalar* x, Pcg
       // interpolated mean. Picking rather than blending outcomes keeps a cell's separate modes.
       CellWeight cw[1u << max_response_axes];
       const std::uint32_t corners = table.corners(x, cw);
-      table.lookup(x, mean);
+      table.interpolate(cw, corners, mean);
       const Scalar u = rng.uniform();
       std::uint32_t pick = corners - 1;
       Scalar below = 0;

@@ -191,6 +191,7 @@ class WorldCore {
     }
     detail::StepContext ctx;
     ctx.dt = dt;
+    ctx.tilted_planes = detail::any_tilted_plane(w_);
     detail::integrate(w_, dt);
     detail::update_radii(w_);
     detail::find_pairs(w_, result);

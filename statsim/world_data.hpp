@@ -42,6 +42,7 @@ struct StepContext {
   std::uint32_t energy_clamps = 0;  ///< sampled responses the energy guard scaled down
   std::uint32_t statistical_responses = 0;  ///< sampled responses applied
   Scalar dt = 0;                    ///< the step's time step, s
+  bool tilted_planes = false;       ///< `any_tilted_plane`: some contact may be on a slope
 };
 
 /// Lever arm of a body in the particle response: its radius for a sphere; 0 for a statistical
