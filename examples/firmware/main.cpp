@@ -92,14 +92,16 @@ constexpr std::uint32_t columns3 = grid_side(bodies, 4, 4, 2);
 constexpr std::uint32_t columns2 = grid_side(bodies, 8, 8, 1);
 
 #if FIRMWARE_I16
-// Quantised at compile time: only the 16-bit tables are in the image.
+// Quantised at compile time (a committed table already in 16 bits is kept as it is): only the
+// 16-bit tables are in the image.
 constexpr auto table3 = statsim::quantize16(FIRMWARE_TABLE);
 constexpr auto table2 = statsim::quantize16(statsim::tables::square2d);
 constexpr auto correlated = statsim::quantize16(statsim::testing::cube_correlated_synthetic);
 constexpr auto empirical = statsim::quantize16(statsim::testing::cube_empirical_synthetic);
 constexpr const char* precision = "i16";
 #else
-constexpr const auto& table3 = FIRMWARE_TABLE;
+// Float tables, also from a committed table in 16 bits, so that both builds step both paths.
+constexpr auto table3 = statsim::dequantize(FIRMWARE_TABLE);
 constexpr const auto& table2 = statsim::tables::square2d;
 constexpr const auto& correlated = statsim::testing::cube_correlated_synthetic;
 constexpr const auto& empirical = statsim::testing::cube_empirical_synthetic;
