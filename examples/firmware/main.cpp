@@ -13,7 +13,7 @@
 // the Cortex-M build.
 
 #include <statsim/config.hpp>
-#ifdef STATSIM_FIRMWARE
+#if defined(STATSIM_FIRMWARE) || defined(STATSIM_WEB)
 // Eigen's own assertion handler prints through stdio: route its checks to statsim's handler.
 #define eigen_assert(x) STATSIM_ASSERT(x)
 #define EIGEN_NO_IO
@@ -59,6 +59,13 @@ void write(const char* text);
 std::uint64_t clock_ticks();  ///< SysTick counts at 25 MHz; 40 instructions each under -icount shift=0
 std::uint32_t stack_used();   ///< high-water mark, bytes
 std::uint32_t stack_size();   ///< bytes
+}  // namespace platform
+#elif defined(STATSIM_WEB)
+// WebAssembly (examples/web): the page or Node gives the output function as an import.
+extern "C" __attribute__((import_module("env"), import_name("statsim_write"))) void statsim_web_write(const char* text);
+namespace platform {
+void write(const char* text) { statsim_web_write(text); }
+[[noreturn]] void fail() { __builtin_trap(); }
 }  // namespace platform
 #else
 #include <cstdio>
