@@ -2,8 +2,10 @@
 //   index.html                 the live scene (controls in the header; ?n=&shape=&rest=&seed= preset them)
 //   index.html?check           runs hash.wasm and hash_i16.wasm (the firmware example's scenes) and
 //                              shows their lines, as the host build prints them
-//   index.html?bench&n=&shape=&steps=&seed=&rest=   pours and steps without drawing, and shows
-//                              one line in the format of web_demo_host
+//   index.html?bench&n=&shape=&steps=&seed=&rest=&warmup=   pours and steps without drawing, and
+//                              shows one line in the format of web_demo_host (after an untimed
+//                              pour of `warmup` steps, default 60, as web_demo_host does: the
+//                              browser swaps its optimised code in while the first steps run)
 // The .wasm files are standalone (no emscripten glue): instantiated here with the one import the
 // hash programs need.
 'use strict';
@@ -66,6 +68,8 @@ async function bench() {
   const steps = Number(params.get('steps') || 600);
   const seed = Number(params.get('seed') || 1);
   const rest = params.get('rest') === '0' ? 0 : 1;
+  const warmup = Number(params.get('warmup') || 60);
+  if (demo.demo_reset(shape, n, rest, seed) !== 0 || demo.demo_step(warmup) !== 0) throw new Error('warm-up failed');
   const status = demo.demo_reset(shape, n, rest, seed);
   if (status !== 0) throw new Error(`demo_reset failed (${status})`);
   const t0 = performance.now();

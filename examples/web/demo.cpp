@@ -3,8 +3,10 @@
 // WebAssembly (statsim.wasm) it exports the C functions below to the page's script (app.js);
 // built for the host with WEB_DEMO_MAIN (web_demo_host) it runs the same scene from the command
 // line, so that the page's step times and state hash can be set beside the native ones:
-//   web_demo_host [--shape bunny|box|lshape|square] [--n N] [--steps S] [--seed S] [--no-rest]
-// prints "web_demo SHAPE bodies N steps S ms_per_step T asleep A hash 0x...".
+//   web_demo_host [--shape bunny|box|lshape|square] [--n N] [--steps S] [--seed S] [--no-rest] [--warmup W]
+// prints "web_demo SHAPE bodies N steps S ms_per_step T asleep A hash 0x...". The timed pour
+// follows an untimed one of W steps (default 60), as the page's does: a browser first runs
+// WebAssembly from a quickly compiled baseline and swaps in optimised code while it runs.
 //
 // The pour draws from the runtime's Pcg32 with arithmetic only (no trigonometry, whose library
 // rounding differs between the host's libm and emscripten's), so a host build and the wasm build
@@ -254,7 +256,7 @@ const float* demo_transforms()
 int main(int argc, char** argv)
 {
   int shape = bunny;
-  unsigned long n = capacity, steps = 600, seed = 1;
+  unsigned long n = capacity, steps = 600, seed = 1, warmup = 60;
   int rest = 1;
   const char* const names[] = {"bunny", "box", "lshape", "square"};
   for (int i = 1; i < argc; ++i) {
@@ -267,14 +269,17 @@ int main(int argc, char** argv)
     } else if (!std::strcmp(argv[i], "--n") && has) n = std::strtoul(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--steps") && has) steps = std::strtoul(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--seed") && has) seed = std::strtoul(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--warmup") && has) warmup = std::strtoul(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--no-rest")) rest = 0;
     else shape = -1;
     if (shape < 0) {
-      std::fprintf(stderr, "usage: web_demo_host [--shape bunny|box|lshape|square] [--n N<=10000] [--steps S] [--seed S] [--no-rest]\n");
+      std::fprintf(stderr, "usage: web_demo_host [--shape bunny|box|lshape|square] [--n N<=10000] [--steps S] [--seed S] [--no-rest] "
+                   "[--warmup W]\n");
       return 2;
     }
   }
-  if (n > capacity || demo_reset(shape, std::uint32_t(n), rest, std::uint32_t(seed)) != 0) {
+  if (n > capacity || demo_reset(shape, std::uint32_t(n), rest, std::uint32_t(seed)) != 0 ||
+      demo_step(int(warmup)) != 0 || demo_reset(shape, std::uint32_t(n), rest, std::uint32_t(seed)) != 0) {
     std::fprintf(stderr, "web_demo_host: could not pour %lu bodies\n", n);
     return 1;
   }
