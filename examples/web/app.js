@@ -139,7 +139,7 @@ async function live() {
     const yaw = 0.6, pitch = 0.52;
     const cy = Math.cos(yaw), sy = Math.sin(yaw), cp = Math.cos(pitch), sp = Math.sin(pitch);
     const distance = 4 * spread;
-    const scale = Math.min(w, 2 * h) / (3.4 * spread);
+    const scale = Math.min(w, 2.1 * h) / (3 * spread);
     const target = 0.15 * spread;
     const project = (x, y, z, out) => {
       const xr = x * cy + y * sy, yr = -x * sy + y * cy, zr = z - target;
@@ -155,7 +155,7 @@ async function live() {
     context.beginPath();
     for (let i = 0; i <= 64; ++i) {
       const a = (i / 64) * 2 * Math.PI;
-      project(1.3 * spread * Math.cos(a), 1.3 * spread * Math.sin(a), 0, p);
+      project(1.2 * spread * Math.cos(a), 1.2 * spread * Math.sin(a), 0, p);
       if (i === 0) context.moveTo(p[0], p[1]);
       else context.lineTo(p[0], p[1]);
     }
