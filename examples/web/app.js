@@ -116,7 +116,7 @@ async function live() {
     depth = new Float32Array(count);
   }
   document.getElementById('reset').addEventListener('click', reset);
-  for (const c of [controls.shape, controls.rest]) c.addEventListener('change', reset);
+  for (const c of Object.values(controls)) c.addEventListener('change', reset);
   reset();
 
   function resize() {

@@ -4,7 +4,8 @@
 //   node chromium.mjs --site BUILD/web/site --modules BUILD/web-node/node_modules MODE
 // MODE:
 //   --check                 index.html?check: the hash lines of the firmware example's scenes
-//   --bench QUERY           index.html?bench&QUERY: one timed pour (e.g. "n=10000&shape=bunny&steps=600")
+//   --bench QUERY           index.html?bench&QUERY: one timed pour (e.g. "n=10000&shape=bunny&steps=600");
+//                           may be given more than once, and with --check
 //   --screenshot FILE.png [--query QUERY] [--steps K]
 //                           the live page (1200 x 700) after K steps (default 240)
 // Options: --chromium PATH (default /usr/bin/chromium), --timeout SECONDS (default 600).
@@ -76,10 +77,14 @@ try {
     const readout = await page.textContent('#readout');
     console.log(`screenshot ${option('--screenshot')} after ${steps} steps: ${readout}`);
   } else {
-    const query = args.includes('--check') ? 'check' : `bench&${option('--bench', '')}`;
-    await page.goto(`${base}?${query}`);
-    await page.waitForFunction(() => !document.getElementById('out').hidden, null, { timeout });
-    process.stdout.write(await page.textContent('#out'));
+    // --check, or every --bench QUERY in turn, each in a fresh load of the page.
+    const queries = args.includes('--check') ? ['check'] : [];
+    args.forEach((a, i) => a === '--bench' && queries.push(`bench&${args[i + 1]}`));
+    for (const query of queries) {
+      await page.goto(`${base}?${query}`);
+      await page.waitForFunction(() => !document.getElementById('out').hidden, null, { timeout });
+      process.stdout.write(await page.textContent('#out'));
+    }
   }
 } catch (error) {
   problems.push(String(error));
