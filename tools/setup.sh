@@ -22,6 +22,10 @@ if [ "$minimal" = 0 ]; then
              libstb-dev libmeshoptimizer-dev libtinyobjloader-dev)
   # The firmware example and its test: Cortex-M toolchain, C and C++ libraries, and the emulator.
   packages+=(gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm)
+  # The web example and its tests (examples/web): emscripten for the .wasm, Debian's chromium for
+  # the browser test. Node.js and npm are the machine's own (emscripten's dependency on nodejs is
+  # met by them); npm installs the test's driver into the build tree.
+  packages+=(emscripten chromium)
   # Pictures: glTF export (tinygltf), GIF writing (giflib) and optimising (gifsicle).
   packages+=(libtinygltf-dev libgif-dev gifsicle)
   # Charts: the plotting scripts of tools/plot (matplotlib for Debian's python3).

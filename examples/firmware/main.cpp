@@ -3,17 +3,18 @@
 // FIRMWARE_STEPS times, then one line per world with the step
 // count and the FNV-1a hash of its whole state (`state_hash()`: positions, orientations,
 // velocities, sleep states, random streams). The same file builds for the host (firmware_host)
-// and, with startup.cpp and mps2-an386.ld, for a Cortex-M4F under QEMU (see CMakeLists.txt here);
-// the two must print the same lines, bit for bit.
+// and, with startup.cpp and mps2-an386.ld, for a Cortex-M4F under QEMU (see CMakeLists.txt here),
+// and for WebAssembly (examples/web: hash.wasm, hash_i16.wasm); all must print the same lines,
+// bit for bit.
 //
 // Build-time choices (-D...): FIRMWARE_BODIES (bodies per world, 64), FIRMWARE_STEPS (2000),
 // FIRMWARE_SHAPE (0 box, 1 L-shape, 2 bunny), FIRMWARE_I16 (1: response tables as 16-bit
 // integers, quantised at compile time by `statsim::quantize16`, the rule of `statsim gather --precision i16`).
 // FIRMWARE_TRACE (defined): also print the hash after every step. STATSIM_FIRMWARE is defined by
-// the Cortex-M build.
+// the Cortex-M build, STATSIM_WEB by the WebAssembly build.
 
 #include <statsim/config.hpp>
-#ifdef STATSIM_FIRMWARE
+#if defined(STATSIM_FIRMWARE) || defined(STATSIM_WEB)
 // Eigen's own assertion handler prints through stdio: route its checks to statsim's handler.
 #define eigen_assert(x) STATSIM_ASSERT(x)
 #define EIGEN_NO_IO
@@ -59,6 +60,13 @@ void write(const char* text);
 std::uint64_t clock_ticks();  ///< SysTick counts at 25 MHz; 40 instructions each under -icount shift=0
 std::uint32_t stack_used();   ///< high-water mark, bytes
 std::uint32_t stack_size();   ///< bytes
+}  // namespace platform
+#elif defined(STATSIM_WEB)
+// WebAssembly (examples/web): the page or Node gives the output function as an import.
+extern "C" __attribute__((import_module("env"), import_name("statsim_write"))) void statsim_web_write(const char* text);
+namespace platform {
+void write(const char* text) { statsim_web_write(text); }
+[[noreturn]] void fail() { __builtin_trap(); }
 }  // namespace platform
 #else
 #include <cstdio>
