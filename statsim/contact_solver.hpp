@@ -364,9 +364,9 @@ std::uint32_t support_pass(WorldData<D>& w, StepContext& ctx)
 template <int D>
 void sort_bottom_up(WorldData<D>& w, std::uint32_t count)
 {
-  const int up = Space<D>::up_axis;
+  constexpr int up = Space<D>::up_axis;
   const Body<D>* bodies = w.bodies;
-  std::sort(w.pairs, w.pairs + count, [bodies, up](const Pair& x, const Pair& y) {
+  std::sort(w.pairs, w.pairs + count, [bodies](const Pair& x, const Pair& y) {
     const Scalar xa = bodies[x.a].position[up], xb = bodies[x.b].position[up];
     const Scalar ya = bodies[y.a].position[up], yb = bodies[y.b].position[up];
     const Scalar kx = xa < xb ? xa : xb, ky = ya < yb ? ya : yb;

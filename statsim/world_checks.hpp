@@ -116,7 +116,7 @@ template <int D>
 Status check_signature_values(const SignatureView<D>& sig)
 {
   constexpr Scalar bound = Scalar(1e6);
-  const auto bad = [bound](Scalar x) { return !(x >= -bound && x <= bound); };  // NaN is bad
+  const auto bad = [](Scalar x) { return !(x >= -bound && x <= bound); };  // NaN is bad
   const auto bad_axis = [&bad](const AxisView& a) {
     for (std::uint32_t i = 0; i < a.size; ++i)
       if (bad(a.values[i]) || (i > 0 && !(a.values[i] > a.values[i - 1]))) return true;
