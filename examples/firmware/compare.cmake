@@ -23,15 +23,8 @@ if(NOT fw_rc EQUAL 0)
   message(FATAL_ERROR "the firmware failed under qemu (${fw_rc})")
 endif()
 
-string(REGEX MATCHALL "(world[23]|models) [^\n]*hash 0x[0-9a-f]+" host_lines "${host_out}")
-string(REGEX MATCHALL "(world[23]|models) [^\n]*hash 0x[0-9a-f]+" fw_lines "${fw_all}")
-list(LENGTH host_lines n)
-if(NOT n EQUAL 3)
-  message(FATAL_ERROR "expected three world lines from the host build, got ${n}")
-endif()
-if(NOT host_lines STREQUAL fw_lines)
-  message(FATAL_ERROR "the firmware's state differs from the host's:\n  host:     ${host_lines}\n  firmware: ${fw_lines}")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/world_lines.cmake)
+expect_same_world_lines("${host_out}" "${fw_all}" 3 "the firmware")
 
 # Under -icount shift=0 a SysTick count (25 MHz) is 40 instructions.
 string(REGEX MATCHALL "firmware: (world[23]|models) systick [0-9]+ steps [0-9]+" clocks "${fw_all}")

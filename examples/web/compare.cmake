@@ -53,15 +53,9 @@ if(NOT web_rc EQUAL 0)
   message(FATAL_ERROR "the web build failed (${web_rc})")
 endif()
 
-string(REGEX MATCHALL "(world[23]|models) [^\n]*hash 0x[0-9a-f]+" host_lines "${host_out}")
-string(REGEX MATCHALL "(world[23]|models) [^\n]*hash 0x[0-9a-f]+" web_lines "${web_out}")
-list(LENGTH host_lines n)
-if(NOT n EQUAL 6)
-  message(FATAL_ERROR "expected six world lines from the host builds (three per precision), got ${n}")
-endif()
-if(NOT host_lines STREQUAL web_lines)
-  message(FATAL_ERROR "the web build's state differs from the host's:\n  host: ${host_lines}\n  web:  ${web_lines}")
-endif()
+# Six lines: three per precision.
+include(${CMAKE_CURRENT_LIST_DIR}/../firmware/world_lines.cmake)
+expect_same_world_lines("${host_out}" "${web_out}" 6 "the web build")
 
 if(DEFINED DEMO_HOST)
   # The time per step differs, the rest must not.
