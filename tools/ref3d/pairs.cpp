@@ -1,0 +1,621 @@
+#include "ref3d/pairs.hpp"
+
+#include "bullet/bullet.hpp"
+#include "bullet/drop_world.hpp"
+#include "common/format.hpp"
+#include "common/parallel.hpp"
+#include "common/progress.hpp"
+#include "common/support_map.hpp"
+#include "ref3d/sampling.hpp"
+#include "scenes/scenes.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace statsim::tools::ref3d {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Random streams (TrialRng's `stream`), apart from gather's.
+constexpr std::uint64_t kPairStream = 11;
+constexpr std::uint64_t kPairHeightStream = 12;
+
+double seconds_since(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+btTransform to_bt(const RigidState& s)
+{
+  return btTransform(btQuaternion(s.orientation.x(), s.orientation.y(), s.orientation.z(), s.orientation.w()),
+                     bullet::to_bt(s.position));
+}
+
+std::vector<bullet::Shapes::Box> shape_boxes(const ShapeModel& m)
+{
+  std::vector<bullet::Shapes::Box> boxes;
+  for (const BodyBox& b : m.boxes) boxes.push_back({b.centre, b.rotation, b.half_extents});
+  return boxes;
+}
+
+// The shape's Bullet geometries for pair queries: its hull without margin (GJK distance) and its
+// true geometry (box, box compound, GImpact mesh) with `margin`.
+struct PairGeometry {
+  bullet::Shapes shapes;
+  btConvexShape* hull = nullptr;
+  btCollisionShape* full = nullptr;
+  bool convex = false;  ///< the true geometry is its hull (a box)
+  PairGeometry(const ShapeModel& m, double margin)
+  {
+    hull = static_cast<btConvexShape*>(shapes.hull(m.hull, 0.0));
+    convex = m.kind == ShapeKind::box;
+    if (m.kind == ShapeKind::mesh) {
+      std::vector<int> idx;
+      for (const auto& t : m.body_mesh.triangles) idx.insert(idx.end(), {t[0], t[1], t[2]});
+      full = shapes.mesh(m.body_mesh.vertices, idx, margin);
+    } else {
+      full = shapes.boxes(shape_boxes(m), margin);
+    }
+  }
+};
+
+// Signed distance of two convex shapes (GJK; negative: they overlap, by EPA's depth).
+double convex_distance(const btConvexShape* a, const btTransform& ta, const btConvexShape* b, const btTransform& tb)
+{
+  btVoronoiSimplexSolver simplex;
+  btGjkEpaPenetrationDepthSolver epa;
+  btGjkPairDetector gjk(a, b, &simplex, &epa);
+  btGjkPairDetector::ClosestPointInput in;
+  in.m_transformA = ta;
+  in.m_transformB = tb;
+  btPointCollector out;
+  gjk.getClosestPoints(in, out, nullptr);
+  return out.m_hasResult ? double(out.m_distance) : -1.0;
+}
+
+// Whether two bodies of the true geometry touch (a manifold point at distance <= 0), by Bullet's
+// narrow phase on a collision world of the two alone; manifolds are cleared before each query,
+// so a query depends only on the two poses.
+class TouchQuery {
+public:
+  explicit TouchQuery(btCollisionShape* shape)
+      : dispatcher_(&config_), world_(&dispatcher_, &broadphase_, &config_)
+  {
+    btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher_);
+    for (btCollisionObject* o : {&a_, &b_}) {
+      o->setCollisionShape(shape);
+      o->setCollisionFlags(0);
+      world_.addCollisionObject(o);
+    }
+  }
+  ~TouchQuery()
+  {
+    world_.removeCollisionObject(&b_);
+    world_.removeCollisionObject(&a_);
+  }
+  bool touching(const btTransform& ta, const btTransform& tb)
+  {
+    a_.setWorldTransform(ta);
+    b_.setWorldTransform(tb);
+    for (int i = 0; i < dispatcher_.getNumManifolds(); ++i) dispatcher_.getManifoldByIndexInternal(i)->clearManifold();
+    world_.performDiscreteCollisionDetection();
+    for (int i = 0; i < dispatcher_.getNumManifolds(); ++i) {
+      const btPersistentManifold* m = dispatcher_.getManifoldByIndexInternal(i);
+      for (int k = 0; k < m->getNumContacts(); ++k)
+        if (m->getContactPoint(k).getDistance() <= 0) return true;
+    }
+    return false;
+  }
+
+private:
+  btDefaultCollisionConfiguration config_;
+  btCollisionDispatcher dispatcher_;
+  btDbvtBroadphase broadphase_;
+  btCollisionWorld world_;
+  btCollisionObject a_, b_;
+};
+
+struct PairStart {
+  RigidState a, b;
+  double rate = 0.0;  ///< bound of the rate at which any two points of the bodies approach, m/s
+};
+
+// Body a at the origin, b 2 L away along +x coming at speed u; both at uniform random
+// orientations, spinning at s u / L about uniform random axes.
+PairStart pair_start(const ShapeModel& m, double spin_ratio, double u, std::uint64_t seed, std::uint64_t index)
+{
+  TrialRng rng(seed, kPairStream, index);
+  const double L = m.bounding_radius;
+  PairStart p;
+  p.a.orientation = rng.rotation();
+  p.a.spin = rng.direction() * (spin_ratio * u / L);
+  p.b.orientation = rng.rotation();
+  p.b.spin = rng.direction() * (spin_ratio * u / L);
+  p.b.position = Eigen::Vector3d(2 * L * (1 + 1e-9), 0, 0);
+  p.b.velocity = Eigen::Vector3d(-u, 0, 0);
+  const FreeFlight flight(m.unit_inertia);
+  p.rate = u + (flight.spin_bound(p.a) + flight.spin_bound(p.b)) * L;
+  return p;
+}
+
+// The pair's states at time t after `s` (each body in its own torque-free flight).
+std::pair<RigidState, RigidState> advance(const FreeFlight& f, const std::pair<RigidState, RigidState>& s, double t)
+{
+  return {f.advance(s.first, t), f.advance(s.second, t)};
+}
+
+double centre_distance(const std::pair<RigidState, RigidState>& s)
+{
+  return (s.second.position - s.first.position).norm();
+}
+
+// Both phases of a pair flight with given geometry (see the header).
+double pair_flight(const ShapeModel& m, PairGeometry& g, TouchQuery* touch, const PairStart& start, bool hull_only,
+                   double* hull_distance)
+{
+  const double L = m.bounding_radius;
+  const FreeFlight flight(m.unit_inertia);
+  std::pair<RigidState, RigidState> s{start.a, start.b};
+  // Hulls: conservative advancement (no two points approach faster than `rate`).
+  const double tol = 1e-7 * L;
+  for (int it = 0; it < 100000; ++it) {
+    const double d = convex_distance(g.hull, to_bt(s.first), g.hull, to_bt(s.second));
+    if (d <= tol) break;
+    s = advance(flight, s, d / start.rate);
+    if (s.second.position.x() < s.first.position.x()) break;  // centres passed: cannot happen for hulls
+  }
+  if (hull_distance) *hull_distance = centre_distance(s);
+  if (hull_only || g.convex || !touch) return centre_distance(s);
+  // True geometry: steps of at most 0.005 L of relative motion, then bisection.
+  const double step = 0.005 * L / start.rate;
+  if (touch->touching(to_bt(s.first), to_bt(s.second))) return centre_distance(s);
+  for (int it = 0; it < 400; ++it) {
+    const auto next = advance(flight, s, step);
+    if (touch->touching(to_bt(next.first), to_bt(next.second))) {
+      double lo = 0, hi = step;
+      for (int k = 0; k < 24; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        const auto x = advance(flight, s, mid);
+        if (touch->touching(to_bt(x.first), to_bt(x.second))) hi = mid;
+        else lo = mid;
+      }
+      return centre_distance(advance(flight, s, hi));
+    }
+    s = next;
+    if (centre_distance(s) < 0.02 * L) break;
+  }
+  return centre_distance(s);
+}
+
+double quantile(const std::vector<double>& sorted, double q)
+{
+  if (sorted.empty()) return 0.0;
+  const double x = q * static_cast<double>(sorted.size() - 1);
+  const std::size_t i = static_cast<std::size_t>(std::floor(x));
+  const std::size_t j = std::min(sorted.size() - 1, i + 1);
+  return sorted[i] + (x - static_cast<double>(i)) * (sorted[j] - sorted[i]);
+}
+
+}  // namespace
+
+Summary summarise(std::vector<double> v)
+{
+  Summary s;
+  s.n = static_cast<int>(v.size());
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  s.mean = sum / static_cast<double>(v.size());
+  double sq = 0.0;
+  for (double x : v) sq += (x - s.mean) * (x - s.mean);
+  s.std = v.size() > 1 ? std::sqrt(sq / static_cast<double>(v.size() - 1)) : 0.0;
+  s.p10 = quantile(v, 0.1);
+  s.p50 = quantile(v, 0.5);
+  s.p90 = quantile(v, 0.9);
+  s.min = v.front();
+  s.max = v.back();
+  return s;
+}
+
+std::vector<Eigen::Vector3d> faces_by_area(const ShapeModel& m)
+{
+  const double L = m.bounding_radius;
+  std::vector<std::pair<double, Eigen::Vector3d>> faces;
+  for (const Eigen::Vector4d& plane : m.hull_planes) {
+    const Eigen::Vector3d n = plane.head<3>();
+    const Eigen::Vector3d a = n.unitOrthogonal(), b = n.cross(a);
+    std::vector<Eigen::Vector2d> pts;
+    for (const Eigen::Vector3d& p : m.hull)
+      if (std::fabs(n.dot(p) - plane.w()) <= 1e-6 * L) pts.emplace_back(a.dot(p), b.dot(p));
+    Eigen::Vector2d c = Eigen::Vector2d::Zero();
+    for (const auto& q : pts) c += q;
+    if (!pts.empty()) c /= static_cast<double>(pts.size());
+    std::sort(pts.begin(), pts.end(), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
+      return std::atan2(p.y() - c.y(), p.x() - c.x()) < std::atan2(q.y() - c.y(), q.x() - c.x());
+    });
+    double area = 0.0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Eigen::Vector2d& p = pts[i];
+      const Eigen::Vector2d& q = pts[(i + 1) % pts.size()];
+      area += 0.5 * (p.x() * q.y() - q.x() * p.y());
+    }
+    faces.emplace_back(area, n);
+  }
+  // Largest first; equal areas in the hull's order.
+  std::stable_sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& f : faces) out.push_back(f.second);
+  return out;
+}
+
+double pair_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index, bool hull_only,
+                  double margin, double* hull_distance)
+{
+  PairGeometry g(model, margin);
+  std::unique_ptr<TouchQuery> touch;
+  if (!hull_only && !g.convex) touch = std::make_unique<TouchQuery>(g.full);
+  return pair_flight(model, g, touch.get(), pair_start(model, spin_ratio, 1.0, seed, index), hull_only,
+                     hull_distance);
+}
+
+namespace {
+
+// The touching pairs of one reference pile (contact points grouped by pair).
+struct PileOutcome {
+  std::vector<PilePair> pairs;
+  int bodies = 0;
+  bool asleep = false;
+};
+
+PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap3& map, std::uint64_t seed)
+{
+  bullet::Shapes shapes;
+  bullet::DropBody body;
+  if (m.kind == ShapeKind::mesh) {
+    std::vector<int> idx;
+    for (const auto& t : m.body_mesh.triangles) idx.insert(idx.end(), {t[0], t[1], t[2]});
+    body.shape = shapes.mesh(m.body_mesh.vertices, idx, bullet::kMargin);
+  } else {
+    body.shape = shapes.boxes(shape_boxes(m), bullet::kMargin);
+  }
+  body.mass = m.mass.mass;
+  body.inertia = m.mass.principal_moments;
+  body.bounding_radius = m.bounding_radius;
+  // statsim bench's Bullet settings (tools/bench/bench_bullet.cpp), the pile reference of
+  // `statsim fidelity`: the table's material, the statsim world's restitution threshold and sleep.
+  bullet::DropSettings s;
+  s.restitution = o.shape.reference.restitution;
+  s.friction = o.shape.reference.friction;
+  s.restitution_threshold = 0.5;
+  s.sleep_speed = 0.05;
+  s.sleep_time = 0.5;
+  s.update_all_aabbs = false;
+  scenes::DropOptions d;
+  d.count = o.pile_count;
+  d.bounding_radius = m.bounding_radius;
+  d.seed = seed;
+  const scenes::DropScene3 scene = scenes::drop_scene3(d);
+  bullet::DropWorld w(body, scene.bodies, s);
+  const long steps = static_cast<long>(std::ceil(o.pile_time / o.pile_dt));
+  PileOutcome out;
+  out.bodies = static_cast<int>(w.size());
+  for (long k = 0; k < steps; ++k) {
+    w.step(o.pile_dt);
+    if (k % 24 == 0 && w.asleep_count() == w.size()) {
+      out.asleep = true;
+      break;
+    }
+  }
+  out.asleep = out.asleep || w.asleep_count() == w.size();
+  const std::vector<Eigen::Vector3d> faces = faces_by_area(m);
+  std::map<std::pair<std::size_t, std::size_t>, std::vector<bullet::DropWorld::BodyContact>> by_pair;
+  for (const auto& c : w.body_contacts(o.touch_distance)) by_pair[{c.a, c.b}].push_back(c);
+  for (const auto& [key, points] : by_pair) {
+    const scenes::BodyState3 a = w.state(key.first), b = w.state(key.second);
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    double deepest = 0.0;
+    for (const auto& c : points) {
+      n += c.normal;
+      deepest = std::max(deepest, -c.distance);
+    }
+    if (!(n.norm() > 0)) continue;
+    n.normalize();
+    const Eigen::Vector3d ab = b.position - a.position;
+    const Eigen::Vector3d e = ab.normalized();
+    const Eigen::Matrix3d ra = a.orientation.toRotationMatrix(), rb = b.orientation.toRotationMatrix();
+    PilePair p;
+    p.distance = ab.norm();
+    p.angle_deg = std::acos(std::min(1.0, std::fabs(e.z()))) * 180.0 / kPi;
+    p.along_normal = ab.dot(n);
+    p.support_e = support(m.hull, ra.transpose() * e) + support(m.hull, -(rb.transpose() * e));
+    p.support_e_map = map.lookup(ra.transpose() * e) + map.lookup(-(rb.transpose() * e));
+    p.support_n = support(m.hull, ra.transpose() * n) + support(m.hull, -(rb.transpose() * n));
+    p.penetration = deepest;
+    const auto exact = [&](const Eigen::Vector3d& u) { return support(m.hull, u); };
+    const auto table = [&](const Eigen::Vector3d& u) { return map.lookup(u); };
+    p.radial6 = radial_estimate(exact, ra, rb, e, faces, 6);
+    p.radial16 = radial_estimate(exact, ra, rb, e, faces, 16);
+    p.radial_all = radial_estimate(exact, ra, rb, e, faces, faces.size());
+    p.radial_map = radial_estimate(table, ra, rb, e, faces, static_cast<std::size_t>(o.candidate_faces));
+    out.pairs.push_back(p);
+  }
+  return out;
+}
+
+}  // namespace
+
+PairResult gather_pairs(const PairOptions& options)
+{
+  PairResult r;
+  r.options = options;
+  const PairOptions& o = options;
+  if (o.trials < 2 || o.height_trials < 2) throw std::runtime_error("--trials and --height-trials must be >= 2");
+  if (o.support_size < 2) throw std::runtime_error("--support-size must be >= 2");
+  validate_gather_options(o.shape);
+  r.model = build_model(o.shape);
+  if (!o.shape.name.empty()) r.model.name = o.shape.name;
+  const ShapeModel& m = r.model;
+  const unsigned threads = o.shape.threads;
+
+  // h_coll at s = 0: the plane's counterpart.
+  {
+    std::vector<double> h(static_cast<std::size_t>(o.height_trials));
+    parallel_for(h.size(), [&](std::size_t i) { h[i] = height_trial(m, 0.0, o.shape.seed ^ kPairHeightStream, i); },
+                 threads);
+    const Summary s = summarise(h);
+    r.h_coll = s.mean;
+    r.h_coll_std = s.std;
+  }
+
+  // Pair distance per spin ratio.
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    const std::size_t ns = o.spin_ratios.size(), nt = static_cast<std::size_t>(o.trials);
+    constexpr std::size_t chunk = 20;
+    const std::size_t chunks = (nt + chunk - 1) / chunk;
+    std::vector<double> dist(ns * nt), hull(ns * nt);
+    Progress progress("pair flights", ns * nt, o.shape.progress);
+    parallel_for(
+        ns * chunks,
+        [&](std::size_t task) {
+          const std::size_t si = task / chunks, c = task % chunks;
+          PairGeometry g(m, o.shape.reference.margin);
+          std::unique_ptr<TouchQuery> touch;
+          if (!g.convex) touch = std::make_unique<TouchQuery>(g.full);
+          for (std::size_t t = c * chunk; t < std::min(nt, (c + 1) * chunk); ++t) {
+            const PairStart st = pair_start(m, o.spin_ratios[si], o.speed, o.shape.seed, si * nt + t);
+            dist[si * nt + t] = pair_flight(m, g, touch.get(), st, false, &hull[si * nt + t]);
+          }
+          progress.add(std::min(nt, (c + 1) * chunk) - c * chunk);
+        },
+        threads);
+    progress.finish();
+    for (std::size_t si = 0; si < ns; ++si) {
+      const Summary s = summarise(std::vector<double>(dist.begin() + si * nt, dist.begin() + (si + 1) * nt));
+      const Summary sh = summarise(std::vector<double>(hull.begin() + si * nt, hull.begin() + (si + 1) * nt));
+      r.pair_mean.push_back(s.mean);
+      r.pair_std.push_back(s.std);
+      r.pair_hull_mean.push_back(sh.mean);
+    }
+    r.pair_flights = static_cast<long long>(ns * nt);
+  }
+  r.pair_seconds = seconds_since(t0);
+
+  // Support maps.
+  for (int size : o.support_sizes) {
+    const SupportMap3 map = SupportMap3::build(m.hull, size);
+    const SupportError e = measure_support_error(map, m.hull, o.support_directions);
+    r.support.push_back({size, 6 * size * size * 4, map.error_bound(m.hull), e.mean, e.max, e.min});
+  }
+  const SupportMap3 map = SupportMap3::build(m.hull, o.support_size);
+  r.support_map = map.values;
+  r.support_bound = map.error_bound(m.hull);
+
+  // Reference piles.
+  const auto t1 = std::chrono::steady_clock::now();
+  if (o.piles > 0) {
+    std::vector<PileOutcome> piles(static_cast<std::size_t>(o.piles));
+    Progress progress("reference piles", piles.size(), o.shape.progress);
+    parallel_for(
+        piles.size(),
+        [&](std::size_t i) {
+          piles[i] = run_pile(m, o, map, i + 1);
+          progress.add(1);
+        },
+        threads);
+    progress.finish();
+    for (const PileOutcome& p : piles) {
+      r.pile_pairs.insert(r.pile_pairs.end(), p.pairs.begin(), p.pairs.end());
+      r.pile_bodies += p.bodies;
+      r.piles_asleep += p.asleep ? 1 : 0;
+    }
+  }
+  r.pile_seconds = seconds_since(t1);
+  return r;
+}
+
+// ---- output ----------------------------------------------------------------------------------
+
+namespace {
+
+using json = nlohmann::json;
+
+json summary_json(const Summary& s)
+{
+  return {{"n", s.n}, {"mean", s.mean}, {"std", s.std}, {"p10", s.p10}, {"p50", s.p50}, {"p90", s.p90},
+          {"min", s.min}, {"max", s.max}};
+}
+
+// The angle bins of the line of centres to the vertical, degrees.
+const std::vector<std::pair<double, double>> kAngleBins = {{0, 30}, {30, 60}, {60, 90.001}, {0, 90.001}};
+
+std::string bin_name(const std::pair<double, double>& b)
+{
+  return b.first == 0 && b.second > 90 ? std::string("all") : num(b.first) + "-" + num(std::floor(b.second)) + " deg";
+}
+
+// The ratios of the pile pairs in an angle bin: what each candidate predicts of the distance.
+struct Ratios {
+  Summary to_hcoll, to_pair, to_support_e, to_support_e_map, normal_to_support_n, residual_support_e_mm,
+      residual_support_n_mm, to_radial6, to_radial16, to_radial_all, to_radial_map, residual_radial_map_mm;
+};
+
+Ratios ratios(const PairResult& r, const std::pair<double, double>& bin)
+{
+  std::vector<double> a, b, c, d, e, f, g, h, i, j, k, l;
+  for (const PilePair& p : r.pile_pairs) {
+    if (!(p.angle_deg >= bin.first && p.angle_deg < bin.second)) continue;
+    h.push_back(p.distance / p.radial6);
+    i.push_back(p.distance / p.radial16);
+    j.push_back(p.distance / p.radial_all);
+    k.push_back(p.distance / p.radial_map);
+    l.push_back(1000 * (p.distance - p.radial_map));
+    a.push_back(p.distance / (2 * r.h_coll));
+    b.push_back(p.distance / r.pair_mean.front());
+    c.push_back(p.distance / p.support_e);
+    d.push_back(p.distance / p.support_e_map);
+    e.push_back(p.along_normal / p.support_n);
+    f.push_back(1000 * (p.distance - p.support_e));
+    g.push_back(1000 * (p.along_normal - p.support_n));
+  }
+  return {summarise(a), summarise(b), summarise(c), summarise(d), summarise(e), summarise(f),
+          summarise(g), summarise(h), summarise(i), summarise(j), summarise(k), summarise(l)};
+}
+
+std::string ms(const Summary& s, const char* f = "%.3f")
+{
+  return fmt(f, s.mean) + " +- " + fmt(f, s.std) + " [" + fmt(f, s.p10) + ", " + fmt(f, s.p90) + "]";
+}
+
+}  // namespace
+
+std::string pairs_json(const PairResult& r, const std::string& command)
+{
+  json j;
+  j["generated_by"] = command;
+  j["shape"] = r.model.name;
+  j["source"] = r.model.source;
+  j["bounding_radius"] = r.model.bounding_radius;
+  j["h_coll"] = {{"spin_ratio", 0.0}, {"mean", r.h_coll}, {"std", r.h_coll_std}, {"flights", r.options.height_trials}};
+  j["pair_distance"] = {{"spin_ratios", r.options.spin_ratios},
+                        {"mean", r.pair_mean},
+                        {"std", r.pair_std},
+                        {"hull_mean", r.pair_hull_mean},
+                        {"flights_per_ratio", r.options.trials},
+                        {"speed", r.options.speed},
+                        {"seconds", r.pair_seconds}};
+  json sup = json::array();
+  for (const SupportRow& s : r.support)
+    sup.push_back({{"size", s.size}, {"bytes_f32", s.bytes}, {"bound", s.bound}, {"mean_error", s.mean},
+                   {"max_error", s.max}, {"min_error", s.min}});
+  j["support_errors"] = sup;
+  std::vector<float> values(r.support_map.begin(), r.support_map.end());
+  std::vector<double> as_float(values.begin(), values.end());
+  j["support_map"] = {{"size", r.options.support_size},
+                      {"layout", "6 faces (+x,-x,+y,-y,+z,-z) x S x S, index (f S + i) S + j, i along axis m+1, j "
+                                 "along m+2, node -1 + 2 i / (S - 1); s(u) = |u_m| bilinear(h)"},
+                      {"bound", r.support_bound},
+                      {"values", as_float}};
+  json piles;
+  piles["piles"] = r.options.piles;
+  piles["bodies"] = r.pile_bodies;
+  piles["piles_asleep"] = r.piles_asleep;
+  piles["pairs"] = r.pile_pairs.size();
+  piles["dt"] = r.options.pile_dt;
+  piles["seconds"] = r.pile_seconds;
+  json bins = json::array();
+  for (const auto& bin : kAngleBins) {
+    const Ratios x = ratios(r, bin);
+    bins.push_back({{"bin", bin_name(bin)},
+                    {"distance_over_2hcoll", summary_json(x.to_hcoll)},
+                    {"distance_over_pair", summary_json(x.to_pair)},
+                    {"distance_over_support_e", summary_json(x.to_support_e)},
+                    {"distance_over_support_e_map", summary_json(x.to_support_e_map)},
+                    {"normal_separation_over_support_n", summary_json(x.normal_to_support_n)},
+                    {"distance_minus_support_e_mm", summary_json(x.residual_support_e_mm)},
+                    {"normal_separation_minus_support_n_mm", summary_json(x.residual_support_n_mm)},
+                    {"distance_over_radial_faces6", summary_json(x.to_radial6)},
+                    {"distance_over_radial_faces16", summary_json(x.to_radial16)},
+                    {"distance_over_radial_all_faces", summary_json(x.to_radial_all)},
+                    {"distance_over_radial_map", summary_json(x.to_radial_map)},
+                    {"distance_minus_radial_map_mm", summary_json(x.residual_radial_map_mm)}});
+  }
+  piles["by_angle"] = bins;
+  j["packing"] = piles;
+  if (r.response_trials > 0) {
+    j["responses"] = {{"trials", r.response_trials},
+                      {"ks_speed", r.ks_speed},
+                      {"ks_spin", r.ks_spin},
+                      {"ks_speed_floor", r.ks_speed_floor},
+                      {"ks_spin_floor", r.ks_spin_floor},
+                      {"bullet_speed", summary_json(r.bullet_speed)},
+                      {"bullet_spin", summary_json(r.bullet_spin)},
+                      {"runtime_speed", summary_json(r.runtime_speed)},
+                      {"runtime_spin", summary_json(r.runtime_spin)},
+                      {"seconds", r.response_seconds}};
+  }
+  return j.dump(2) + "\n";
+}
+
+std::string pairs_markdown(const PairResult& r, const std::string& command)
+{
+  std::ostringstream s;
+  const double L = r.model.bounding_radius;
+  s << "### " << r.model.name << "\n\n`" << command << "`\n\n";
+  s << "L = " << fmt("%.4f", L) << " m; h_coll (s = 0) = " << fmt("%.4f", r.h_coll) << " m (std "
+    << fmt("%.4f", r.h_coll_std) << "), 2 h_coll = " << fmt("%.4f", 2 * r.h_coll) << " m.\n\n";
+  s << "Pair distance at first contact (" << r.options.trials << " flights per spin ratio, " << fmt("%.1f", r.pair_seconds)
+    << " s):\n\n| spin ratio | mean (m) | std (m) | mean / 2 h_coll | hulls' mean (m) |\n|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < r.pair_mean.size(); ++i)
+    s << "| " << num(r.options.spin_ratios[i]) << " | " << fmt("%.4f", r.pair_mean[i]) << " | "
+      << fmt("%.4f", r.pair_std[i]) << " | " << fmt("%.3f", r.pair_mean[i] / (2 * r.h_coll)) << " | "
+      << fmt("%.4f", r.pair_hull_mean[i]) << " |\n";
+  s << "\nSupport cube map against the exact hull support (" << r.options.support_directions
+    << " random directions), errors in units of L:\n\n| S | bytes (f32) | bound | mean | max |\n|---|---|---|---|---|\n";
+  for (const SupportRow& x : r.support)
+    s << "| " << x.size << " | " << x.bytes << " | " << fmt("%.4f", x.bound / L) << " | " << fmt("%.5f", x.mean / L)
+      << " | " << fmt("%.4f", x.max / L) << " |\n";
+  if (!r.pile_pairs.empty()) {
+    s << "\nPacking in " << r.options.piles << " reference piles of " << r.options.pile_count << " (" << r.piles_asleep
+      << " all asleep, " << r.pile_pairs.size() << " touching pairs, " << fmt("%.1f", r.pile_seconds)
+      << " s): ratio mean +- std [p10, p90]; residuals in mm.\n\n";
+    s << "| angle of e to vertical | pairs | d / 2 h_coll | d / pair distance | d / support(e) | d / map(e) | "
+         "(d.n) / support(n) | d - support(e) (mm) | d.n - support(n) (mm) |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& bin : kAngleBins) {
+      const Ratios x = ratios(r, bin);
+      s << "| " << bin_name(bin) << " | " << x.to_hcoll.n << " | " << ms(x.to_hcoll) << " | " << ms(x.to_pair) << " | "
+        << ms(x.to_support_e) << " | " << ms(x.to_support_e_map) << " | " << ms(x.normal_to_support_n) << " | "
+        << ms(x.residual_support_e_mm, "%.1f") << " | " << ms(x.residual_support_n_mm, "%.1f") << " |\n";
+    }
+    s << "\nThe same pairs against the upper bound min over candidate normals n of support sum / (n.e) "
+         "(radial_estimate): candidates e and the hull's K largest faces of either body.\n\n"
+         "| angle of e to vertical | d / K = 6 | d / K = 16 | d / all faces | d / map, K = "
+      << r.options.candidate_faces << " | d - map (mm) |\n|---|---|---|---|---|---|\n";
+    for (const auto& bin : kAngleBins) {
+      const Ratios x = ratios(r, bin);
+      s << "| " << bin_name(bin) << " | " << ms(x.to_radial6) << " | " << ms(x.to_radial16) << " | "
+        << ms(x.to_radial_all) << " | " << ms(x.to_radial_map) << " | " << ms(x.residual_radial_map_mm, "%.1f") << " |\n";
+    }
+  }
+  if (r.response_trials > 0) {
+    s << "\nPair responses (" << r.response_trials << " impacts): KS runtime vs Bullet |v+|/|v-| " << fmt("%.3f", r.ks_speed)
+      << " (floor " << fmt("%.3f", r.ks_speed_floor) << "), |w+| L/|v-| " << fmt("%.3f", r.ks_spin) << " (floor "
+      << fmt("%.3f", r.ks_spin_floor) << "); Bullet |v+|/|v-| " << ms(r.bullet_speed) << ", runtime " << ms(r.runtime_speed)
+      << "; Bullet |w+| L/|v-| " << ms(r.bullet_spin) << ", runtime " << ms(r.runtime_spin) << " ("
+      << fmt("%.1f", r.response_seconds) << " s).\n";
+  }
+  return s.str();
+}
+
+}  // namespace statsim::tools::ref3d
