@@ -8,6 +8,10 @@
 #include "common/support_map.hpp"
 #include "ref3d/sampling.hpp"
 #include "scenes/scenes.hpp"
+#include "statsim/world3.hpp"
+#include "tables/box.hpp"
+#include "tables/bunny.hpp"
+#include "tables/lshape.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -159,10 +163,14 @@ double centre_distance(const std::pair<RigidState, RigidState>& s)
   return (s.second.position - s.first.position).norm();
 }
 
-// Both phases of a pair flight with given geometry (see the header).
-double pair_flight(const ShapeModel& m, PairGeometry& g, TouchQuery* touch, const PairStart& start, bool hull_only,
-                   double* hull_distance)
+// Both phases of a pair flight with given geometry (see the header); `out`: the states at contact.
+double pair_flight_states(const ShapeModel& m, PairGeometry& g, TouchQuery* touch, const PairStart& start,
+                          bool hull_only, double* hull_distance, std::pair<RigidState, RigidState>& out)
 {
+  const auto done = [&](const std::pair<RigidState, RigidState>& x) {
+    out = x;
+    return centre_distance(x);
+  };
   const double L = m.bounding_radius;
   const FreeFlight flight(m.unit_inertia);
   std::pair<RigidState, RigidState> s{start.a, start.b};
@@ -175,10 +183,10 @@ double pair_flight(const ShapeModel& m, PairGeometry& g, TouchQuery* touch, cons
     if (s.second.position.x() < s.first.position.x()) break;  // centres passed: cannot happen for hulls
   }
   if (hull_distance) *hull_distance = centre_distance(s);
-  if (hull_only || g.convex || !touch) return centre_distance(s);
+  if (hull_only || g.convex || !touch) return done(s);
   // True geometry: steps of at most 0.005 L of relative motion, then bisection.
   const double step = 0.005 * L / start.rate;
-  if (touch->touching(to_bt(s.first), to_bt(s.second))) return centre_distance(s);
+  if (touch->touching(to_bt(s.first), to_bt(s.second))) return done(s);
   for (int it = 0; it < 400; ++it) {
     const auto next = advance(flight, s, step);
     if (touch->touching(to_bt(next.first), to_bt(next.second))) {
@@ -189,12 +197,21 @@ double pair_flight(const ShapeModel& m, PairGeometry& g, TouchQuery* touch, cons
         if (touch->touching(to_bt(x.first), to_bt(x.second))) hi = mid;
         else lo = mid;
       }
-      return centre_distance(advance(flight, s, hi));
+      return done(advance(flight, s, hi));
     }
     s = next;
     if (centre_distance(s) < 0.02 * L) break;
   }
-  return centre_distance(s);
+  return done(s);
+}
+
+double pair_flight(const ShapeModel& m, PairGeometry& g, TouchQuery* touch, const PairStart& start, bool hull_only,
+                   double* hull_distance, std::pair<RigidState, RigidState>* at_contact = nullptr)
+{
+  std::pair<RigidState, RigidState> contact;
+  const double d = pair_flight_states(m, g, touch, start, hull_only, hull_distance, contact);
+  if (at_contact) *at_contact = contact;
+  return d;
 }
 
 double quantile(const std::vector<double>& sorted, double q)
@@ -204,6 +221,138 @@ double quantile(const std::vector<double>& sorted, double q)
   const std::size_t i = static_cast<std::size_t>(std::floor(x));
   const std::size_t j = std::min(sorted.size() - 1, i + 1);
   return sorted[i] + (x - static_cast<double>(i)) * (sorted[j] - sorted[i]);
+}
+
+// The outcome of one pair impact: |v_b+ - v_a+| / u and |w_b+| L / u (u the approach speed).
+struct PairOutcome {
+  double speed = 0.0, spin = 0.0;
+};
+
+// Bullet: the two bodies of the true geometry from their states at first contact, b moved a
+// hair towards a so that the first step has the contact, with the reference's settings (those
+// of `statsim gather`'s impacts: ref3d/reference.hpp) and each body's material the square root
+// of the pair's (Bullet multiplies them), until they have been apart for 50 steps.
+PairOutcome bullet_pair_impact(const ShapeModel& m, btCollisionShape* shape, const ReferenceSettings& rs,
+                               std::pair<RigidState, RigidState> s, double u)
+{
+  const double L = m.bounding_radius;
+  const Eigen::Vector3d e = (s.second.position - s.first.position).normalized();
+  s.second.position -= 1e-6 * L * e;
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher(&config);
+  btGImpactCollisionAlgorithm::registerAlgorithm(&dispatcher);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
+  world.setGravity(btVector3(0, 0, 0));
+  btContactSolverInfo& info = world.getSolverInfo();
+  info.m_numIterations = rs.solver_iterations;
+  info.m_restitutionVelocityThreshold = rs.restitution_threshold;
+  info.m_splitImpulse = rs.split_impulse ? 1 : 0;
+  info.m_splitImpulsePenetrationThreshold = rs.split_impulse ? 1e30 : -0.04;
+  info.m_erp = rs.erp;
+  info.m_erp2 = rs.erp;
+  info.m_linearSlop = 0.0;
+  info.m_solverMode = SOLVER_USE_2_FRICTION_DIRECTIONS | (rs.warm_starting ? SOLVER_USE_WARMSTARTING : 0);
+  std::unique_ptr<btRigidBody> body[2];
+  for (int k = 0; k < 2; ++k) {
+    const RigidState& st = k ? s.second : s.first;
+    btRigidBody::btRigidBodyConstructionInfo bi(m.mass.mass, nullptr, shape, bullet::to_bt(m.mass.principal_moments));
+    bi.m_startWorldTransform = to_bt(st);
+    bi.m_restitution = std::sqrt(rs.restitution);
+    bi.m_friction = std::sqrt(rs.friction);
+    bi.m_linearDamping = 0.0;
+    bi.m_angularDamping = 0.0;
+    body[k] = std::make_unique<btRigidBody>(bi);
+    body[k]->setFlags(BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY);
+    body[k]->setActivationState(DISABLE_DEACTIVATION);
+    if (!rs.speculative_contacts) body[k]->setContactProcessingThreshold(0.0);
+    body[k]->setLinearVelocity(bullet::to_bt(st.velocity));
+    body[k]->setAngularVelocity(bullet::to_bt(st.spin));
+    world.addRigidBody(body[k].get());
+  }
+  const int max_steps = static_cast<int>(std::ceil(2.0 / rs.dt));
+  int apart = 0;
+  for (int step = 0; step < max_steps && apart < 50; ++step) {
+    world.stepSimulation(rs.dt, 0, rs.dt);
+    bool touching = false;
+    for (int i = 0; i < dispatcher.getNumManifolds(); ++i) {
+      const btPersistentManifold* mf = dispatcher.getManifoldByIndexInternal(i);
+      for (int k = 0; k < mf->getNumContacts(); ++k) touching = touching || mf->getContactPoint(k).getDistance() <= 0;
+    }
+    apart = touching ? 0 : apart + 1;
+  }
+  PairOutcome o;
+  const Eigen::Vector3d va = bullet::to_eigen(body[0]->getLinearVelocity());
+  const Eigen::Vector3d vb = bullet::to_eigen(body[1]->getLinearVelocity());
+  o.speed = (vb - va).norm() / u;
+  o.spin = bullet::to_eigen(body[1]->getAngularVelocity()).norm() * L / u;
+  world.removeRigidBody(body[1].get());
+  world.removeRigidBody(body[0].get());
+  return o;
+}
+
+// The runtime: a World3 without gravity or planes holding the two bodies at the same
+// orientations, velocities and spins, their centres along the same line at 0.999 of the sum of
+// their collision radii, stepped at 1/240 s until they separate (at most 0.25 s).
+PairOutcome runtime_pair_impact(const SignatureView<3>& sig, double L, const std::pair<RigidState, RigidState>& s,
+                                double u, std::uint64_t seed)
+{
+  WorldDef3 def;
+  def.gravity = Vector3::Zero();
+  def.seed = seed;
+  auto w = std::make_unique<World3<2>>(def);
+  const ShapeId shape = w->add_shape(sig).id;
+  const Eigen::Vector3d e = (s.second.position - s.first.position).normalized();
+  Scalar radius[2];
+  BodyDef3 def_[2];
+  for (int k = 0; k < 2; ++k) {
+    const RigidState& st = k ? s.second : s.first;
+    BodyDef3& b = def_[k];
+    b.shape = shape;
+    b.orientation = st.orientation.cast<Scalar>();
+    b.linear_velocity = st.velocity.cast<Scalar>();
+    b.angular_velocity = st.spin.cast<Scalar>();
+    radius[k] = collision_radius<3>(sig, b.linear_velocity, b.angular_velocity);
+  }
+  def_[1].position = (e * (0.999 * double(radius[0] + radius[1]))).cast<Scalar>();
+  if (!w->add_body(def_[0]).ok() || !w->add_body(def_[1]).ok()) throw std::runtime_error("runtime: add_body failed");
+  for (int step = 0; step < 60; ++step) {
+    if (!w->step(Scalar(1) / 240).ok()) throw std::runtime_error("runtime: step failed");
+    const Vector3 rel = w->body(1).position - w->body(0).position;
+    const Vector3 dv = w->body(1).linear_velocity - w->body(0).linear_velocity;
+    if (rel.norm() > radius[0] + radius[1] && rel.dot(dv) > 0) break;
+  }
+  PairOutcome o;
+  o.speed = double((w->body(1).linear_velocity - w->body(0).linear_velocity).norm()) / u;
+  o.spin = double(w->body(1).angular_velocity.norm()) * L / u;
+  return o;
+}
+
+// Two-sample Kolmogorov-Smirnov distance.
+double ks(std::vector<double> a, std::vector<double> b)
+{
+  if (a.empty() || b.empty()) return 0.0;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  std::size_t i = 0, j = 0;
+  double d = 0.0;
+  while (i < a.size() && j < b.size()) {
+    const double x = std::min(a[i], b[j]);
+    while (i < a.size() && a[i] <= x) ++i;
+    while (j < b.size() && b[j] <= x) ++j;
+    d = std::max(d, std::fabs(static_cast<double>(i) / static_cast<double>(a.size()) - static_cast<double>(j) / static_cast<double>(b.size())));
+  }
+  return d;
+}
+
+bool table_for(const std::string& name, SignatureView<3>& out)
+{
+  if (name == "box") out = tables::box.view();
+  else if (name == "lshape") out = tables::lshape.view();
+  else if (name == "bunny") out = tables::bunny.view();
+  else return false;
+  return true;
 }
 
 }  // namespace
@@ -329,8 +478,8 @@ PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap
       n += c.normal;
       deepest = std::max(deepest, -c.distance);
     }
-    if (!(n.norm() > 0)) continue;
-    n.normalize();
+    // Points of a nested pair can point opposite ways: then the first stands.
+    n = n.norm() > 0.5 ? Eigen::Vector3d(n.normalized()) : points.front().normal;
     const Eigen::Vector3d ab = b.position - a.position;
     const Eigen::Vector3d e = ab.normalized();
     const Eigen::Matrix3d ra = a.orientation.toRotationMatrix(), rb = b.orientation.toRotationMatrix();
@@ -442,6 +591,57 @@ PairResult gather_pairs(const PairOptions& options)
     }
   }
   r.pile_seconds = seconds_since(t1);
+
+  // Pair responses: Bullet against the runtime from the same contact states.
+  const auto t2 = std::chrono::steady_clock::now();
+  SignatureView<3> sig{};
+  if (o.response_trials > 0 && o.shape.box_size.empty() && o.shape.mesh_file.empty() && table_for(o.shape.shape, sig)) {
+    const std::size_t n = static_cast<std::size_t>(o.response_trials);
+    std::vector<PairOutcome> ref(n), run(n), ref_b(n);
+    Progress progress("pair impacts", n, o.shape.progress);
+    parallel_for(
+        n,
+        [&](std::size_t i) {
+          PairGeometry g(m, o.shape.reference.margin);
+          std::unique_ptr<TouchQuery> touch;
+          if (!g.convex) touch = std::make_unique<TouchQuery>(g.full);
+          // Spin ratios spread uniformly over 0..2, as impacts in a pile.
+          TrialRng rng(o.shape.seed, kPairStream + 2, i);
+          const double spin = 2.0 * rng.uniform();
+          const PairStart st = pair_start(m, spin, o.speed, o.shape.seed + 7, i);
+          std::pair<RigidState, RigidState> contact;
+          pair_flight(m, g, touch.get(), st, false, nullptr, &contact);
+          ref[i] = bullet_pair_impact(m, g.full, o.shape.reference, contact, o.speed);
+          run[i] = runtime_pair_impact(sig, m.bounding_radius, contact, o.speed, o.shape.seed + i);
+          // A second, independent reference sample: the noise floor of the KS distances.
+          TrialRng rng_b(o.shape.seed, kPairStream + 3, i);
+          const PairStart st_b = pair_start(m, 2.0 * rng_b.uniform(), o.speed, o.shape.seed + 8, i);
+          pair_flight(m, g, touch.get(), st_b, false, nullptr, &contact);
+          ref_b[i] = bullet_pair_impact(m, g.full, o.shape.reference, contact, o.speed);
+          progress.add(1);
+        },
+        threads);
+    progress.finish();
+    std::vector<double> bs, bw, rs, rw, bs2, bw2;
+    for (std::size_t i = 0; i < n; ++i) {
+      bs.push_back(ref[i].speed);
+      bw.push_back(ref[i].spin);
+      rs.push_back(run[i].speed);
+      rw.push_back(run[i].spin);
+      bs2.push_back(ref_b[i].speed);
+      bw2.push_back(ref_b[i].spin);
+    }
+    r.response_trials = static_cast<int>(n);
+    r.ks_speed = ks(bs, rs);
+    r.ks_spin = ks(bw, rw);
+    r.ks_speed_floor = ks(bs, bs2);
+    r.ks_spin_floor = ks(bw, bw2);
+    r.bullet_speed = summarise(bs);
+    r.bullet_spin = summarise(bw);
+    r.runtime_speed = summarise(rs);
+    r.runtime_spin = summarise(rw);
+  }
+  r.response_seconds = seconds_since(t2);
   return r;
 }
 

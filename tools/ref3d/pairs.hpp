@@ -19,10 +19,12 @@
 //    of centres e, s_a(R_a^T e) + s_b(-R_b^T e), exact and by the cube map; and the centre
 //    separation along the contact normal n against the support along n. Ratios binned by the
 //    angle of e to the vertical.
-// 4. Responses: pair impacts in Bullet (two bodies head-on as in 1, the true geometry, the
-//    reference's settings) against the runtime's body-body response (World3, the shape's table,
-//    PairResponse::momentum, no gravity) from the same states; Kolmogorov-Smirnov distance of
-//    |v+| and |w+| L of one body in the pair's centre-of-mass frame, over |v-|.
+// 4. Responses: pair impacts in Bullet (two bodies head-on as in 1 from their states at first
+//    contact, spin ratios uniform in 0..2, the true geometry, the reference's settings) against
+//    the runtime's body-body response (World3 with the shape's committed table, the default
+//    PairResponse::momentum, no gravity) from the same states; Kolmogorov-Smirnov distance of the
+//    relative speed after the impact |v_b+ - v_a+| / u and of one body's spin |w_b+| L / u, and
+//    its noise floor: the KS distance of a second, independent Bullet sample.
 #pragma once
 
 #include "ref3d/gather.hpp"
@@ -98,7 +100,7 @@ struct PairResult {
   // responses
   int response_trials = 0;
   double ks_speed = 0.0, ks_spin = 0.0;  ///< KS distance runtime vs Bullet
-  double ks_speed_floor = 0.0, ks_spin_floor = 0.0;  ///< KS of Bullet's two halves
+  double ks_speed_floor = 0.0, ks_spin_floor = 0.0;  ///< KS of two independent Bullet samples
   Summary bullet_speed, bullet_spin, runtime_speed, runtime_spin;
   double response_seconds = 0.0;
 };
