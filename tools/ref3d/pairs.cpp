@@ -409,13 +409,13 @@ std::vector<Eigen::Vector3d> faces_by_area(const ShapeModel& m)
 }
 
 double pair_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index, bool hull_only,
-                  double margin, double* hull_distance)
+                  double margin, double* hull_distance, std::pair<RigidState, RigidState>* at_contact)
 {
   PairGeometry g(model, margin);
   std::unique_ptr<TouchQuery> touch;
   if (!hull_only && !g.convex) touch = std::make_unique<TouchQuery>(g.full);
   return pair_flight(model, g, touch.get(), pair_start(model, spin_ratio, 1.0, seed, index), hull_only,
-                     hull_distance);
+                     hull_distance, at_contact);
 }
 
 namespace {

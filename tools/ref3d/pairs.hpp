@@ -32,6 +32,7 @@
 #include <algorithm>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace statsim::tools::ref3d {
@@ -132,9 +133,11 @@ double radial_estimate(const Support& support, const Eigen::Matrix3d& ra, const 
 }
 
 /// One pair flight (exposed for the tests): centre distance at the first contact, m, of the
-/// hulls (hull_only) or of the true geometry.
+/// hulls (hull_only) or of the true geometry (Bullet's, with `margin`); the hulls' distance and
+/// the two states at contact when asked for.
 double pair_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index,
-                  bool hull_only, double margin, double* hull_distance = nullptr);
+                  bool hull_only, double margin, double* hull_distance = nullptr,
+                  std::pair<RigidState, RigidState>* at_contact = nullptr);
 
 /// Runs everything the options ask for (deterministic for a seed, any thread count).
 PairResult gather_pairs(const PairOptions& options);
