@@ -408,6 +408,13 @@ std::vector<Eigen::Vector3d> faces_by_area(const ShapeModel& m)
   return out;
 }
 
+std::vector<double> face_offsets(const ShapeModel& m, const std::vector<Eigen::Vector3d>& faces)
+{
+  std::vector<double> out;
+  for (const Eigen::Vector3d& f : faces) out.push_back(support(m.hull, f));
+  return out;
+}
+
 double pair_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index, bool hull_only,
                   double margin, double* hull_distance, std::pair<RigidState, RigidState>* at_contact)
 {
@@ -468,6 +475,7 @@ PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap
   }
   out.asleep = out.asleep || w.asleep_count() == w.size();
   const std::vector<Eigen::Vector3d> faces = faces_by_area(m);
+  const std::vector<double> offsets = face_offsets(m, faces);
   std::map<std::pair<std::size_t, std::size_t>, std::vector<bullet::DropWorld::BodyContact>> by_pair;
   for (const auto& c : w.body_contacts(o.touch_distance)) by_pair[{c.a, c.b}].push_back(c);
   for (const auto& [key, points] : by_pair) {
@@ -496,7 +504,7 @@ PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap
     p.radial6 = radial_estimate(exact, ra, rb, e, faces, 6);
     p.radial16 = radial_estimate(exact, ra, rb, e, faces, 16);
     p.radial_all = radial_estimate(exact, ra, rb, e, faces, faces.size());
-    p.radial_map = radial_estimate(table, ra, rb, e, faces, static_cast<std::size_t>(o.candidate_faces));
+    p.radial_map = radial_estimate(table, ra, rb, e, faces, static_cast<std::size_t>(o.candidate_faces), &offsets);
     out.pairs.push_back(p);
   }
   return out;

@@ -30,6 +30,7 @@
 #include "ref3d/gather.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <utility>
@@ -43,9 +44,11 @@ struct PairOptions {
   int trials = 400;                  ///< pair flights per spin ratio
   int height_trials = 2000;          ///< plane flights for h_coll at s = 0
   std::vector<int> support_sizes = {3, 5, 9, 17, 33};
-  int support_size = 9;              ///< S of the stored cube map
+  int support_size = 17;             ///< S of the stored cube map
   int support_directions = 100000;   ///< directions of the error measurement
-  int candidate_faces = 16;          ///< hull faces (largest first) tried as contact normals
+  /// Hull faces (largest first) tried as contact normals by the stored table's estimate (the
+  /// face's own body by its offset, the other body by the cube map).
+  int candidate_faces = 16;
   int piles = 4;                     ///< reference piles (scene seeds 1..piles)
   int pile_count = 50;               ///< bodies per pile
   double pile_dt = 1.0 / 240.0;      ///< s
@@ -112,25 +115,36 @@ std::vector<Eigen::Vector3d> faces_by_area(const ShapeModel& model);
 /// The distance along the unit line of centres e (from a to b) at which the hulls of two bodies
 /// at orientations ra, rb touch, estimated from above: for every unit n with n.e > 0 the hulls
 /// are apart while (c_b - c_a).n exceeds s_a(ra^T n) + s_b(-rb^T n), so the contact distance is
-/// at most min over n of [s_a(ra^T n) + s_b(-rb^T n)] / (n.e). Candidates: e, the faces
-/// `faces` of a (n = ra f) and of b (n = -rb f). `support` maps a body-frame unit direction to
-/// the body's support (exact or a table). Exact when the contact normal is a candidate.
+/// at most min over n of [s_a(ra^T n) + s_b(-rb^T n)] / (n.e). Candidates: e, and the first
+/// `count` of `faces` (outward face normals, body frame) of a (n = ra f) and of b (n = -rb f).
+/// `support` maps a body-frame unit direction to the body's support (exact or a table); with
+/// `offsets` (the faces' distances from the centre) a body's support along its own face is
+/// that offset, and only the other body's is looked up. Exact when the contact normal is a
+/// candidate and the support exact.
 template <class Support>
 double radial_estimate(const Support& support, const Eigen::Matrix3d& ra, const Eigen::Matrix3d& rb,
-                       const Eigen::Vector3d& e, const std::vector<Eigen::Vector3d>& faces, std::size_t count)
+                       const Eigen::Vector3d& e, const std::vector<Eigen::Vector3d>& faces, std::size_t count,
+                       const std::vector<double>* offsets = nullptr)
 {
-  const auto along = [&](const Eigen::Vector3d& n) {
+  const auto along = [&](const Eigen::Vector3d& n, double sa, double sb) {
     const double c = n.dot(e);
     if (!(c > 1e-6)) return std::numeric_limits<double>::infinity();
-    return (support(ra.transpose() * n) + support(-(rb.transpose() * n))) / c;
+    const double a = std::isnan(sa) ? support(ra.transpose() * n) : sa;
+    const double b = std::isnan(sb) ? support(-(rb.transpose() * n)) : sb;
+    return (a + b) / c;
   };
-  double best = along(e);
+  const double lookup = std::numeric_limits<double>::quiet_NaN();
+  double best = along(e, lookup, lookup);
   for (std::size_t k = 0; k < std::min(count, faces.size()); ++k) {
-    best = std::min(best, along(ra * faces[k]));
-    best = std::min(best, along(-(rb * faces[k])));
+    const double own = offsets ? (*offsets)[k] : lookup;
+    best = std::min(best, along(ra * faces[k], own, lookup));
+    best = std::min(best, along(-(rb * faces[k]), lookup, own));
   }
   return best;
 }
+
+/// The offsets (distance from the centre of mass, m) of the faces of faces_by_area, in order.
+std::vector<double> face_offsets(const ShapeModel& model, const std::vector<Eigen::Vector3d>& faces);
 
 /// One pair flight (exposed for the tests): centre distance at the first contact, m, of the
 /// hulls (hull_only) or of the true geometry (Bullet's, with `margin`); the hulls' distance and
