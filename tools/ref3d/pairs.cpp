@@ -33,6 +33,7 @@ constexpr double kPi = 3.14159265358979323846;
 // Random streams (TrialRng's `stream`), apart from gather's.
 constexpr std::uint64_t kPairStream = 11;
 constexpr std::uint64_t kPairHeightStream = 12;
+constexpr std::uint64_t kBinStream = 16;
 
 double seconds_since(std::chrono::steady_clock::time_point t0)
 {
@@ -457,12 +458,30 @@ PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap
   s.sleep_speed = 0.05;
   s.sleep_time = 0.5;
   s.update_all_aabbs = false;
-  scenes::DropOptions d;
-  d.count = o.pile_count;
-  d.bounding_radius = m.bounding_radius;
-  d.seed = seed;
-  const scenes::DropScene3 scene = scenes::drop_scene3(d);
-  bullet::DropWorld w(body, scene.bodies, s);
+  std::vector<scenes::BodyState3> states;
+  if (o.bin > 0) {
+    const double L = m.bounding_radius, half = o.bin * L, cell = 2.1 * L;
+    const int side = std::max(1, static_cast<int>(std::floor(2 * half / cell)));
+    for (const Eigen::Vector3d& n : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                     Eigen::Vector3d(0, -1, 0)})
+      s.planes.push_back({n, -half});
+    for (int i = 0; i < o.pile_count; ++i) {
+      TrialRng rng(seed, kBinStream, static_cast<std::uint64_t>(i));
+      const int layer = i / (side * side), k = i % (side * side);
+      scenes::BodyState3 b;
+      b.position = Eigen::Vector3d(-half + cell * (0.5 + k % side), -half + cell * (0.5 + k / side),
+                                   1.05 * L + cell * layer);
+      b.orientation = rng.rotation();
+      states.push_back(b);
+    }
+  } else {
+    scenes::DropOptions d;
+    d.count = o.pile_count;
+    d.bounding_radius = m.bounding_radius;
+    d.seed = seed;
+    states = scenes::drop_scene3(d).bodies;
+  }
+  bullet::DropWorld w(body, states, s);
   const long steps = static_cast<long>(std::ceil(o.pile_time / o.pile_dt));
   PileOutcome out;
   out.bodies = static_cast<int>(w.size());

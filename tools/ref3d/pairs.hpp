@@ -12,8 +12,9 @@
 //    refined by bisection. Starting at 2 L apart makes the phase of the approach uniform.
 // 2. Support map: the cube map of the hull's support function (common/support_map.hpp) at
 //    several sizes S: its bound and its error against the exact support.
-// 3. Packing in reference piles: drop_scene3 piles of the shape in Bullet with statsim bench's
-//    settings (the pile reference of `statsim fidelity`), run until every body sleeps; for every
+// 3. Packing in reference piles: drop_scene3 piles of the shape (or a bin, PairOptions::bin) in
+//    Bullet with statsim bench's settings (the pile reference of `statsim fidelity`), run until
+//    every body sleeps; for every
 //    pair of bodies in contact (manifold points within `touch_distance`), the centre distance
 //    against 2 h_coll (s = 0), the pair distance at s = 0, and the hull support along the line
 //    of centres e, s_a(R_a^T e) + s_b(-R_b^T e), exact and by the cube map; and the centre
@@ -54,6 +55,10 @@ struct PairOptions {
   double pile_dt = 1.0 / 240.0;      ///< s
   double pile_time = 20.0;           ///< s: a pile still awake then is used as it is
   double touch_distance = 0.002;     ///< m: a manifold point this close counts as a contact
+  /// > 0: instead of drop_scene3, a bin: four walls at +-bin L around the vertical axis, the
+  /// bodies at rest on a square lattice of cells 2.1 L wide filling it layer by layer from 1.05 L
+  /// up, each at a uniform random orientation (so they stack).
+  double bin = 0.0;
   int response_trials = 0;           ///< pair impacts for 4. (0: none)
   double speed = 2.0;                ///< m/s, relative approach speed of 1. and 4.
 };

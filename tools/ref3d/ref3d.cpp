@@ -405,6 +405,10 @@ void add_gather_pairs(CLI::App& app)
   sub->add_option("--pile-count", o.pile_count, "Bodies per pile")->capture_default_str();
   sub->add_option("--pile-dt", o.pile_dt, "Bullet step of the piles, s")->capture_default_str();
   sub->add_option("--pile-time", o.pile_time, "Longest pile run, s")->capture_default_str();
+  sub->add_option("--bin", o.bin,
+                  "Piles in a bin instead: walls at +-BIN L, bodies stacked on a lattice at random orientations (0: "
+                  "drop_scene3)")
+      ->capture_default_str();
   sub->add_option("--touch-distance", o.touch_distance, "Manifold points this close are contacts, m")
       ->capture_default_str();
   sub->add_option("--response-trials", o.response_trials, "Pair impacts compared with the runtime (0: none)")
