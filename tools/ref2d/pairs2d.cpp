@@ -145,18 +145,22 @@ std::vector<Eigen::Vector2d> edge_normals(const std::vector<Eigen::Vector2d>& hu
 }
 
 // min over n in {e} and the edge normals of either body of support sum / (n.e) (see
-// ref3d/pairs.hpp radial_estimate).
+// ref3d/pairs.hpp radial_estimate); along its own edge a body's support is the edge's offset.
 template <class Support>
 double radial2(const Support& s, const Eigen::Matrix2d& ra, const Eigen::Matrix2d& rb, const Eigen::Vector2d& e,
-               const std::vector<Eigen::Vector2d>& normals)
+               const std::vector<Eigen::Vector2d>& normals, const std::vector<double>& offsets)
 {
-  const auto along = [&](const Eigen::Vector2d& n) {
+  const auto along = [&](const Eigen::Vector2d& n, double sa, double sb) {
     const double c = n.dot(e);
     if (!(c > 1e-6)) return std::numeric_limits<double>::infinity();
-    return (s(ra.transpose() * n) + s(-(rb.transpose() * n))) / c;
+    return (sa + sb) / c;
   };
-  double best = along(e);
-  for (const auto& f : normals) best = std::min({best, along(ra * f), along(-(rb * f))});
+  double best = along(e, s(ra.transpose() * e), s(-(rb.transpose() * e)));
+  for (std::size_t k = 0; k < normals.size(); ++k) {
+    const Eigen::Vector2d na = ra * normals[k], nb = -(rb * normals[k]);
+    best = std::min({best, along(na, offsets[k], s(-(rb.transpose() * na))),
+                     along(nb, s(ra.transpose() * nb), offsets[k])});
+  }
   return best;
 }
 
@@ -218,6 +222,8 @@ std::vector<Pairs2dPile> run_pile(const Pairs2dOptions& o, const Shape2& shape, 
   }
   const std::vector<Eigen::Vector2d> hull = to_eigen(shape.hull);
   const std::vector<Eigen::Vector2d> edges = edge_normals(hull);
+  std::vector<double> offsets;
+  for (const Eigen::Vector2d& n : edges) offsets.push_back(support(hull, n));
   const auto exact = [&](const Eigen::Vector2d& u) { return support(hull, u); };
   const auto table = [&](const Eigen::Vector2d& u) { return map.lookup(u); };
   std::vector<Pairs2dPile> out;
@@ -236,8 +242,8 @@ std::vector<Pairs2dPile> run_pile(const Pairs2dOptions& o, const Shape2& shape, 
     p.support_e = exact(ra.transpose() * e) + exact(-(rb.transpose() * e));
     p.support_e_map = table(ra.transpose() * e) + table(-(rb.transpose() * e));
     p.support_n = exact(ra.transpose() * n) + exact(-(rb.transpose() * n));
-    p.radial = radial2(exact, ra, rb, e, edges);
-    p.radial_map = radial2(table, ra, rb, e, edges);
+    p.radial = radial2(exact, ra, rb, e, edges, offsets);
+    p.radial_map = radial2(table, ra, rb, e, edges, offsets);
     out.push_back(p);
   }
   return out;
@@ -393,6 +399,29 @@ std::string pairs2d_json(const Pairs2dResult& r, const std::string& command)
       b[c.name] = {{"n", s.n}, {"mean", s.mean}, {"std", s.std}, {"p10", s.p10}, {"p90", s.p90}};
     }
     bins.push_back(b);
+  }
+  {
+    const Shape2 shape = shape_of(r.options.shape);
+    const std::vector<Eigen::Vector2d> hull = to_eigen(shape.hull);
+    json normals = json::array(), offsets = json::array();
+    for (const Eigen::Vector2d& n : edge_normals(hull)) {
+      normals.push_back({static_cast<double>(static_cast<float>(n.x())), static_cast<double>(static_cast<float>(n.y()))});
+      offsets.push_back(static_cast<double>(static_cast<float>(support(hull, n))));
+    }
+    json mean = json::array(), sd = json::array(), count = json::array();
+    for (std::size_t b = 0; b < 3; ++b) {
+      const Stat x = column_stat(r, kColumns[5], kBins[b]);
+      mean.push_back(x.n > 0 ? x.mean : 1.0);
+      sd.push_back(x.std);
+      count.push_back(x.n);
+    }
+    // The proposed table fields in one place (tools/ref3d/README.md, "Body-body statistics").
+    j["table"] = {{"pair_spin_ratios", r.options.spin_ratios}, {"pair_mean", r.pair_mean},
+                  {"pair_stddev", r.pair_std},                 {"support_size", r.options.support_size},
+                  {"support", as_float},                       {"edge_normals", normals},
+                  {"edge_offsets", offsets},                   {"packing_bins_deg", {0, 30, 60, 90}},
+                  {"packing_mean", mean},                      {"packing_stddev", sd},
+                  {"packing_pairs", count}};
   }
   j["packing"] = {{"drops", r.options.drops}, {"bodies", r.bodies},     {"drops_asleep", r.asleep},
                   {"pairs", r.pile_pairs.size()}, {"seconds", r.pile_seconds}, {"by_angle", bins}};

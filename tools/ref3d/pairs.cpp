@@ -780,6 +780,37 @@ std::string pairs_json(const PairResult& r, const std::string& command)
   }
   piles["by_angle"] = bins;
   j["packing"] = piles;
+  // The proposed table fields in one place (tools/ref3d/README.md, "Body-body statistics").
+  {
+    const std::vector<Eigen::Vector3d> faces = faces_by_area(r.model);
+    const std::vector<double> offsets = face_offsets(r.model, faces);
+    const std::size_t k = std::min<std::size_t>(faces.size(), static_cast<std::size_t>(r.options.candidate_faces));
+    json normals = json::array(), off = json::array();
+    for (std::size_t i = 0; i < k; ++i) {
+      normals.push_back({static_cast<double>(static_cast<float>(faces[i].x())),
+                         static_cast<double>(static_cast<float>(faces[i].y())),
+                         static_cast<double>(static_cast<float>(faces[i].z()))});
+      off.push_back(static_cast<double>(static_cast<float>(offsets[i])));
+    }
+    json packing_mean = json::array(), packing_std = json::array(), packing_n = json::array();
+    for (std::size_t b = 0; b < 3; ++b) {
+      const Ratios x = ratios(r, kAngleBins[b]);
+      packing_mean.push_back(x.to_radial_map.n > 0 ? x.to_radial_map.mean : 1.0);
+      packing_std.push_back(x.to_radial_map.std);
+      packing_n.push_back(x.to_radial_map.n);
+    }
+    j["table"] = {{"pair_spin_ratios", r.options.spin_ratios},
+                  {"pair_mean", r.pair_mean},
+                  {"pair_stddev", r.pair_std},
+                  {"support_size", r.options.support_size},
+                  {"support", as_float},
+                  {"face_normals", normals},
+                  {"face_offsets", off},
+                  {"packing_bins_deg", {0, 30, 60, 90}},
+                  {"packing_mean", packing_mean},
+                  {"packing_stddev", packing_std},
+                  {"packing_pairs", packing_n}};
+  }
   if (r.response_trials > 0) {
     j["responses"] = {{"trials", r.response_trials},
                       {"ks_speed", r.ks_speed},
