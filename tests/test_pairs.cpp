@@ -8,6 +8,7 @@
 #include "support/temp_dir.hpp"
 
 #include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
 
 #include <Eigen/Geometry>
 
@@ -222,4 +223,42 @@ TEST_CASE("2D pair flights: squares between face and corner contact, nested L-sh
     nested += l < hull - 1e-3;
   }
   CHECK(nested > 10);
+}
+
+TEST_CASE("gather-pairs writes the same JSON whatever the thread count, with the proposed fields")
+{
+  PairOptions o;
+  o.shape.shape = "box";
+  o.spin_ratios = {0, 2};
+  o.trials = 8;
+  o.height_trials = 50;
+  o.support_sizes = {3};
+  o.support_size = 5;
+  o.support_directions = 1000;
+  o.piles = 2;
+  o.pile_count = 6;
+  o.pile_time = 3;
+  o.bin = 1.1;  // one cell wide: a column
+  o.response_trials = 6;
+  o.shape.threads = 1;
+  const std::string one = pairs_json(gather_pairs(o), "cmd");
+  o.shape.threads = 2;
+  const PairResult r = gather_pairs(o);
+  CHECK(pairs_json(r, "cmd") == one);
+  const nlohmann::json j = nlohmann::json::parse(one);
+  CHECK(j["table"]["support"].size() == 6u * 5 * 5);
+  CHECK(j["table"]["face_normals"].size() == 6u);
+  CHECK(j["table"]["pair_mean"].size() == 2u);
+  CHECK(j["table"]["packing_mean"].size() == 3u);
+  CHECK(r.response_trials == 6);
+  // The column in its narrow bin: boxes on boxes, where the estimate from the faces is exact
+  // and 2 h_coll is far off.
+  int upright = 0;
+  for (const PilePair& p : r.pile_pairs) {
+    if (p.angle_deg > 30) continue;
+    ++upright;
+    CHECK(p.distance == doctest::Approx(p.radial_map).epsilon(0.01));
+    CHECK(p.distance < 0.8 * 2 * r.h_coll);
+  }
+  CHECK(upright >= 6);
 }

@@ -370,7 +370,7 @@ Stat column_stat(const Pairs2dResult& r, const Column& c, const std::pair<double
 
 std::string pairs2d_json(const Pairs2dResult& r, const std::string& command)
 {
-  using json = nlohmann::json;
+  using json = nlohmann::ordered_json;
   json j;
   j["generated_by"] = command;
   j["shape"] = r.options.shape;
@@ -378,7 +378,7 @@ std::string pairs2d_json(const Pairs2dResult& r, const std::string& command)
   j["h_coll"] = r.h_coll;
   j["pair_distance"] = {{"spin_ratios", r.options.spin_ratios}, {"mean", r.pair_mean},     {"std", r.pair_std},
                         {"hull_mean", r.hull_mean},            {"flights_per_ratio", r.options.trials},
-                        {"speed", r.options.speed},            {"seconds", r.pair_seconds}};
+                        {"speed", r.options.speed}};
   json sup = json::array();
   for (const auto& s : r.support)
     sup.push_back({{"size", s.size}, {"bound", s.bound}, {"mean_error", s.mean}, {"max_error", s.max}});
@@ -424,7 +424,7 @@ std::string pairs2d_json(const Pairs2dResult& r, const std::string& command)
                   {"packing_pairs", count}};
   }
   j["packing"] = {{"drops", r.options.drops}, {"bodies", r.bodies},     {"drops_asleep", r.asleep},
-                  {"pairs", r.pile_pairs.size()}, {"seconds", r.pile_seconds}, {"by_angle", bins}};
+                  {"pairs", r.pile_pairs.size()}, {"by_angle", bins}};
   return j.dump(2) + "\n";
 }
 

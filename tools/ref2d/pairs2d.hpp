@@ -67,6 +67,7 @@ double pair_trial2d(const std::string& shape, double spin_ratio, std::uint64_t s
                     bool hull_only);
 
 Pairs2dResult gather_pairs2d(const Pairs2dOptions& options);
+/// As ref3d::pairs_json: the command first, no timings, the proposed fields under "table".
 std::string pairs2d_json(const Pairs2dResult& r, const std::string& command);
 std::string pairs2d_markdown(const Pairs2dResult& r, const std::string& command);
 

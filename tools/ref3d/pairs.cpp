@@ -676,7 +676,7 @@ PairResult gather_pairs(const PairOptions& options)
 
 namespace {
 
-using json = nlohmann::json;
+using json = nlohmann::ordered_json;
 
 json summary_json(const Summary& s)
 {
@@ -740,8 +740,7 @@ std::string pairs_json(const PairResult& r, const std::string& command)
                         {"std", r.pair_std},
                         {"hull_mean", r.pair_hull_mean},
                         {"flights_per_ratio", r.options.trials},
-                        {"speed", r.options.speed},
-                        {"seconds", r.pair_seconds}};
+                        {"speed", r.options.speed}};
   json sup = json::array();
   for (const SupportRow& s : r.support)
     sup.push_back({{"size", s.size}, {"bytes_f32", s.bytes}, {"bound", s.bound}, {"mean_error", s.mean},
@@ -760,7 +759,6 @@ std::string pairs_json(const PairResult& r, const std::string& command)
   piles["piles_asleep"] = r.piles_asleep;
   piles["pairs"] = r.pile_pairs.size();
   piles["dt"] = r.options.pile_dt;
-  piles["seconds"] = r.pile_seconds;
   json bins = json::array();
   for (const auto& bin : kAngleBins) {
     const Ratios x = ratios(r, bin);
@@ -820,8 +818,7 @@ std::string pairs_json(const PairResult& r, const std::string& command)
                       {"bullet_speed", summary_json(r.bullet_speed)},
                       {"bullet_spin", summary_json(r.bullet_spin)},
                       {"runtime_speed", summary_json(r.runtime_speed)},
-                      {"runtime_spin", summary_json(r.runtime_spin)},
-                      {"seconds", r.response_seconds}};
+                      {"runtime_spin", summary_json(r.runtime_spin)}};
   }
   return j.dump(2) + "\n";
 }

@@ -161,7 +161,11 @@ double pair_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed
 /// Runs everything the options ask for (deterministic for a seed, any thread count).
 PairResult gather_pairs(const PairOptions& options);
 
+/// The JSON: "generated_by" (the regenerating command) first, then every statistic and, under
+/// "table", the fields proposed for the signature. No timings (they are in the markdown), so a
+/// run with the same options writes the same bytes whatever the thread count.
 std::string pairs_json(const PairResult& r, const std::string& command);
+/// The markdown report, with the gathering's times.
 std::string pairs_markdown(const PairResult& r, const std::string& command);
 
 }  // namespace statsim::tools::ref3d
