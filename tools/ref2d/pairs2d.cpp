@@ -386,10 +386,10 @@ std::string pairs2d_json(const Pairs2dResult& r, const std::string& command)
   std::vector<double> as_float;
   for (double v : r.support_map) as_float.push_back(static_cast<double>(static_cast<float>(v)));
   j["support_map"] = {{"size", r.options.support_size},
+                      {"values", "table.support"},
                       {"layout", "4 sides (+x,-x,+y,-y) x S, index f S + i, i along the other axis, node -1 + 2 i / "
                                  "(S - 1); s(u) = |u_m| linear(h)"},
-                      {"bound", r.support_bound},
-                      {"values", as_float}};
+                      {"bound", r.support_bound}};
   json bins = json::array();
   for (const auto& bin : kBins) {
     json b;

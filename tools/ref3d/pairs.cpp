@@ -749,10 +749,10 @@ std::string pairs_json(const PairResult& r, const std::string& command)
   std::vector<float> values(r.support_map.begin(), r.support_map.end());
   std::vector<double> as_float(values.begin(), values.end());
   j["support_map"] = {{"size", r.options.support_size},
+                      {"values", "table.support"},
                       {"layout", "6 faces (+x,-x,+y,-y,+z,-z) x S x S, index (f S + i) S + j, i along axis m+1, j "
                                  "along m+2, node -1 + 2 i / (S - 1); s(u) = |u_m| bilinear(h)"},
-                      {"bound", r.support_bound},
-                      {"values", as_float}};
+                      {"bound", r.support_bound}};
   json piles;
   piles["piles"] = r.options.piles;
   piles["bodies"] = r.pile_bodies;
