@@ -201,6 +201,7 @@ DropWorld::DropWorld(const DropBody& body, const std::vector<scenes::BodyState3>
     const Eigen::Quaterniond& q = s.orientation;
     info.m_startWorldTransform = btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), to_bt(s.position));
     auto rb = std::make_unique<btRigidBody>(info);
+    rb->setUserIndex(static_cast<int>(m.bodies.size()));
     rb->setLinearVelocity(to_bt(s.linear_velocity));
     rb->setAngularVelocity(to_bt(s.angular_velocity));
     if (!settings.sleeping) rb->setActivationState(DISABLE_DEACTIVATION);
@@ -258,6 +259,34 @@ std::size_t DropWorld::touching_pairs() const
   std::size_t k = 0;
   for (int i = 0; i < d->getNumManifolds(); ++i) k += d->getManifoldByIndexInternal(i)->getNumContacts() > 0;
   return k;
+}
+
+std::vector<DropWorld::BodyContact> DropWorld::body_contacts(double max_distance) const
+{
+  btDispatcher* d = impl_->world->getDispatcher();
+  std::vector<BodyContact> out;
+  for (int i = 0; i < d->getNumManifolds(); ++i) {
+    const btPersistentManifold* m = d->getManifoldByIndexInternal(i);
+    const auto* b0 = btRigidBody::upcast(m->getBody0());
+    const auto* b1 = btRigidBody::upcast(m->getBody1());
+    if (!b0 || !b1 || b0->getInvMass() == 0 || b1->getInvMass() == 0) continue;
+    const bool swap = b0->getUserIndex() > b1->getUserIndex();
+    for (int k = 0; k < m->getNumContacts(); ++k) {
+      const btManifoldPoint& p = m->getContactPoint(k);
+      if (p.getDistance() > max_distance) continue;
+      BodyContact c;
+      // m_normalWorldOnB points from body 1 towards body 0.
+      const Eigen::Vector3d n = to_eigen(p.m_normalWorldOnB);
+      c.a = static_cast<std::size_t>(swap ? b1->getUserIndex() : b0->getUserIndex());
+      c.b = static_cast<std::size_t>(swap ? b0->getUserIndex() : b1->getUserIndex());
+      c.normal = swap ? n : Eigen::Vector3d(-n);
+      c.point_a = to_eigen(swap ? p.getPositionWorldOnB() : p.getPositionWorldOnA());
+      c.point_b = to_eigen(swap ? p.getPositionWorldOnA() : p.getPositionWorldOnB());
+      c.distance = p.getDistance();
+      out.push_back(c);
+    }
+  }
+  return out;
 }
 
 double DropWorld::deepest_penetration() const

@@ -117,6 +117,15 @@ public:
   std::size_t asleep_count() const;
   /// Contact manifolds holding at least one point (touching pairs, planes included).
   std::size_t touching_pairs() const;
+  /// A contact point between two dropped bodies (planes left out).
+  struct BodyContact {
+    std::size_t a = 0, b = 0;        ///< body indices, a < b
+    Eigen::Vector3d normal;          ///< world frame, unit, from a towards b
+    Eigen::Vector3d point_a, point_b;  ///< world frame, on each body, m
+    double distance = 0.0;           ///< m, negative when penetrating
+  };
+  /// Every contact point of every body-body manifold at a distance of at most `max_distance`, m.
+  std::vector<BodyContact> body_contacts(double max_distance) const;
   /// Deepest penetration of any contact point, m (0 when nothing penetrates).
   double deepest_penetration() const;
   /// Time of the last step() spent in the broad phase (AABB update and pair search) and in the

@@ -13,10 +13,11 @@ namespace statsim::tools {
 void register_mesh_commands(CLI::App& app);
 /// Box2D experiments: `fig3` (the paper's Figure 3), then `gather2d` and `compare2d` (tools/ref2d).
 void register_ref2d_commands(CLI::App& app);
-/// `gather2d` (a 2D shape's signature tables) and `compare2d` (Box2D vs statsim's World2).
+/// `gather2d` (a 2D shape's signature tables), `compare2d` (Box2D vs statsim's World2) and
+/// `gather-pairs2d` (body-body statistics with Box2D).
 void register_gather2d_commands(CLI::App& app);
 /// `gather`: a shape's statistical signature measured with Bullet, written as a C++ table and
-/// optionally as JSON (tools/ref3d).
+/// optionally as JSON; `gather-pairs`: body-body statistics with Bullet (tools/ref3d).
 void register_ref3d_commands(CLI::App& app);
 /// `bench`: time per step against Bullet and Box2D (tools/bench).
 void register_bench_commands(CLI::App& app);

@@ -1,5 +1,6 @@
 // `statsim gather2d`: see gather2d.hpp.
 #include "ref2d/gather2d.hpp"
+#include "ref2d/pairs2d.hpp"
 #include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
@@ -977,6 +978,7 @@ void register_gather2d_commands(CLI::App& app)
   g->callback([cmd]() { run_gather2d_command(*cmd); });
 
   register_compare2d_command(app);
+  register_pairs2d_command(app);
 }
 
 }  // namespace statsim::tools

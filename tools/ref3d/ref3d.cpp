@@ -4,6 +4,7 @@
 #include "common/atomic_file.hpp"
 #include "ref3d/cell_report.hpp"
 #include "ref3d/gather.hpp"
+#include "ref3d/pairs.hpp"
 #include "ref3d/sizing.hpp"
 
 #include <CLI/CLI.hpp>
@@ -367,11 +368,90 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   sub->callback([c, sub]() { run(*c, *sub); });
 }
 
+void add_gather_pairs(CLI::App& app)
+{
+  struct Command {
+    PairOptions o;
+    std::string json, report;
+    bool quiet = false;
+  };
+  auto c = std::make_shared<Command>();
+  PairOptions& o = c->o;
+  CLI::App* sub = app.add_subcommand(
+      "gather-pairs",
+      "Body-body statistics of a 3D shape with Bullet: centre distance at first contact of two bodies against spin, "
+      "the hull's support cube map and its error, packing of touching pairs in reference piles, pair responses "
+      "(tools/ref3d/pairs.hpp)");
+  auto* shape = sub->add_option("--shape", o.shape.shape, "Built-in shape: box, lshape or bunny")
+                    ->check(CLI::IsMember({"box", "lshape", "bunny"}))
+                    ->capture_default_str();
+  auto* mesh = sub->add_option("--mesh", o.shape.mesh_file, "Any closed OBJ mesh (GImpact)")->excludes(shape);
+  sub->add_option("--box-size", o.shape.box_size, "A box of this size X,Y,Z in m instead")
+      ->delimiter(',')
+      ->expected(3)
+      ->excludes(shape)
+      ->excludes(mesh);
+  sub->add_option("--name", o.shape.name, "Name in the outputs (default: the shape's)");
+  sub->add_option("--spin-ratios", o.spin_ratios, "Spin ratios |w| L / |v| of the pair flights")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--trials", o.trials, "Pair flights per spin ratio")->capture_default_str();
+  sub->add_option("--height-trials", o.height_trials, "Plane flights for h_coll at spin ratio 0")->capture_default_str();
+  sub->add_option("--support-sizes", o.support_sizes, "Cube-map sizes S whose error is measured")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--support-size", o.support_size, "S of the stored cube map (6 S^2 values)")->capture_default_str();
+  sub->add_option("--piles", o.piles, "Reference piles (drop_scene3 seeds 1..N; 0: none)")->capture_default_str();
+  sub->add_option("--pile-count", o.pile_count, "Bodies per pile")->capture_default_str();
+  sub->add_option("--pile-dt", o.pile_dt, "Bullet step of the piles, s")->capture_default_str();
+  sub->add_option("--pile-time", o.pile_time, "Longest pile run, s")->capture_default_str();
+  sub->add_option("--bin", o.bin,
+                  "Piles in a bin instead: walls at +-BIN L, bodies stacked on a lattice at random orientations (0: "
+                  "drop_scene3)")
+      ->capture_default_str();
+  sub->add_option("--touch-distance", o.touch_distance, "Manifold points this close are contacts, m")
+      ->capture_default_str();
+  sub->add_option("--response-trials", o.response_trials, "Pair impacts compared with the runtime (0: none)")
+      ->capture_default_str();
+  sub->add_option("--speed", o.speed, "Relative approach speed of the pair flights and impacts, m/s")
+      ->capture_default_str();
+  sub->add_option("--seed", o.shape.seed, "Random seed")->capture_default_str();
+  sub->add_option("--threads", o.shape.threads, "Worker threads (0 = all hardware threads)")->capture_default_str();
+  sub->add_option("--json", c->json, "Write the statistics as JSON to this file");
+  sub->add_option("--report", c->report, "Write the markdown report to this file");
+  sub->add_flag("--quiet", c->quiet, "No progress on stderr");
+  sub->callback([c, sub]() {
+    try {
+      PairOptions opts = c->o;
+      opts.shape.progress = !c->quiet;
+      std::string cmd = std::string(kStatsim) + " gather-pairs";
+      for (const CLI::Option* opt : sub->get_options()) {
+        const std::string name = opt->get_name(false, true);
+        if (opt->count() == 0 || name.rfind("--", 0) != 0 || name == "--threads" || name == "--quiet" ||
+            name == "--json" || name == "--report")
+          continue;
+        std::string value;
+        for (const std::string& r : opt->results()) value += (value.empty() ? "" : ",") + r;
+        cmd += " " + name + " " + quote(value);
+      }
+      const PairResult r = gather_pairs(opts);
+      const std::string md = pairs_markdown(r, cmd);
+      if (!c->json.empty()) write_file_atomic(c->json, pairs_json(r, cmd));
+      if (!c->report.empty()) write_file_atomic(c->report, md);
+      std::cout << md;
+    } catch (const std::exception& e) {
+      std::cerr << "statsim gather-pairs: error: " << e.what() << "\n";
+      throw CLI::RuntimeError(1);
+    }
+  });
+}
+
 }  // namespace
 
 void register_ref3d_commands(CLI::App& app)
 {
   add_gather(app, &std::cout, &std::cerr);
+  add_gather_pairs(app);
 }
 
 int run_gather_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err)
