@@ -193,12 +193,14 @@ const char* scenes_definitions()
          "square of side 2.1 R at (1.5 + 0.75 N^(1/3)) 2.1 R above the origin, 1 m/s downwards, random orientations "
          "(waiting asleep far above until released); bin: --bin-count bodies in a "
          "lattice of --bin-cells x --bin-cells cells of 2.1 R between four wall planes, layer by layer; both run "
-         "until every body rests (asleep, or slower than 0.01 m/s for 0.5 s) or --time-limit. column, wall: "
+         "until every body rests (asleep, or slower than 0.01 m/s for 0.5 s) or --time-limit (the heap: after its last "
+         "release). column, wall: "
          "--column-height bodies, or --wall-columns columns of --wall-height, in a rest pose (the first box's "
          "faces along the world axes), touching, no velocity; measured after --stack-time s.\n"
-         "angle_deg: radial bins of width R about the centres' mean (x, y); each bin's top is its highest centre; "
-         "least squares z = a + b r over the tops from the highest bin outward, up to the first empty bin or the "
-         "first top less than R/2 above the lowest centre; atan(-b) in degrees (0 with fewer than 2 bins). height: "
+         "angle_deg: 8 angular sectors and radial bins of width R about the centres' mean (x, y); each cell's top is "
+         "its highest centre; least squares z = a + b r over the tops of every sector from its highest cell outward, "
+         "up to its first empty cell or first top less than R/2 above the lowest centre; atan(-b) in degrees (0 with "
+         "fewer than 2 tops). height: "
          "the highest centre, m. fill_height: twice the mean centre height, m. packing: N V / (A fill_height), V the "
          "mesh's volume, A the bin's floor area. held: the highest centre's height over the highest placed centre's "
          "(1: the true height). overlap: deepest penetration between boxes of different bodies (separating axis "
@@ -970,9 +972,9 @@ std::string describe_scene(const scenes::PileScene3& sc, const FidelityOptions& 
   if (sc.kind == "heap")
     std::snprintf(b, sizeof b,
                   "heap: %zu bodies poured one every %.3g s from 4 points %.3g m apart at %.3g m above the origin, "
-                  "%.3g m/s downwards, onto the ground; runs end when all rest after the last release or at %.3g s",
+                  "%.3g m/s downwards, onto the ground; runs end when all rest after the last release or %.3g s after it",
                   sc.bodies.size(), sc.release_time.size() > 1 ? sc.release_time[1] : 0.0, sc.cell, sc.nozzle_height,
-                  sc.release.empty() ? 0.0 : -sc.release.front().linear_velocity.z(), o.time_limit);
+                  sc.pour_speed, o.time_limit);
   else if (sc.kind == "bin")
     std::snprintf(b, sizeof b,
                   "bin: %zu bodies in a square bin of inner side %.3g m (%d x %d cells of %.3g m, layers from %.3g m), "
@@ -1012,7 +1014,8 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
     sim = bench::make_statsim3_table(m.table, setup.body.mass, drop, world_seed, dt, "", m.variant, walls);
   }
   const bool stack = sc.kind == "column" || sc.kind == "wall";
-  const double limit = stack ? o.stack_time : o.time_limit;
+  // The heap's time limit counts from its last release.
+  const double limit = stack ? o.stack_time : o.time_limit + (sc.release_time.empty() ? 0.0 : sc.release_time.back());
   const std::size_t n = sc.bodies.size();
   std::vector<double> quiet_since(n, -1);
   const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));

@@ -104,6 +104,7 @@ PileScene3 heap_scene(const HeapOptions& o)
   }
   const double n = static_cast<double>(o.count);
   sc.nozzle_height = (1.5 + 0.75 * std::cbrt(n)) * s;
+  sc.pour_speed = o.pour_speed;
   // The waiting lattice: side g cells, g^2 >= N, layers from 10 s above the nozzle.
   int g = 1;
   while (g * g < o.count) ++g;
@@ -212,10 +213,10 @@ void rotated_extent(const std::vector<Eigen::Vector3d>& points, const Eigen::Qua
   }
 }
 
-HeapProfile heap_profile(const std::vector<Eigen::Vector3d>& centres, double bin, double toe)
+HeapProfile heap_profile(const std::vector<Eigen::Vector3d>& centres, double bin, double toe, int sectors)
 {
   HeapProfile out;
-  if (centres.empty() || !(bin > 0)) return out;
+  if (centres.empty() || !(bin > 0) || sectors < 1) return out;
   Eigen::Vector2d axis = Eigen::Vector2d::Zero();
   double low = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& c : centres) {
@@ -224,21 +225,28 @@ HeapProfile heap_profile(const std::vector<Eigen::Vector3d>& centres, double bin
     out.height = std::max(out.height, c.z());
   }
   axis /= static_cast<double>(centres.size());
-  // Each bin's top: the highest centre in it, as (r, z); r < 0 marks an empty bin.
-  std::vector<std::array<double, 2>> top;
+  // top[sector][bin]: the highest centre of the cell as (r, z); r < 0 marks an empty cell.
+  const std::array<double, 2> empty{-1.0, -std::numeric_limits<double>::infinity()};
+  std::vector<std::vector<std::array<double, 2>>> top(static_cast<std::size_t>(sectors));
   for (const Eigen::Vector3d& c : centres) {
-    const double r = (c.head<2>() - axis).norm();
+    const Eigen::Vector2d d = c.head<2>() - axis;
+    const double r = d.norm();
+    const double turn = std::atan2(d.y(), d.x()) / (2 * kPi) + 0.5;  // in [0, 1]
+    const std::size_t s = std::min(static_cast<std::size_t>(turn * sectors), static_cast<std::size_t>(sectors - 1));
     const std::size_t k = static_cast<std::size_t>(std::floor(r / bin));
-    if (top.size() <= k) top.resize(k + 1, {-1.0, -std::numeric_limits<double>::infinity()});
-    if (c.z() > top[k][1]) top[k] = {r, c.z()};
+    std::vector<std::array<double, 2>>& t = top[s];
+    if (t.size() <= k) t.resize(k + 1, empty);
+    if (c.z() > t[k][1]) t[k] = {r, c.z()};
   }
-  std::size_t peak = 0;
-  for (std::size_t k = 1; k < top.size(); ++k)
-    if (top[k][1] > top[peak][1]) peak = k;
   double n = 0, sr = 0, sz = 0, srr = 0, srz = 0;
-  for (std::size_t k = peak; k < top.size(); ++k) {
-    if (top[k][0] < 0 || top[k][1] < low + toe) break;
-    n += 1, sr += top[k][0], sz += top[k][1], srr += top[k][0] * top[k][0], srz += top[k][0] * top[k][1];
+  for (const std::vector<std::array<double, 2>>& t : top) {
+    std::size_t peak = 0;
+    for (std::size_t k = 1; k < t.size(); ++k)
+      if (t[k][1] > t[peak][1]) peak = k;
+    for (std::size_t k = peak; k < t.size(); ++k) {
+      if (t[k][0] < 0 || t[k][1] < low + toe) break;
+      n += 1, sr += t[k][0], sz += t[k][1], srr += t[k][0] * t[k][0], srz += t[k][0] * t[k][1];
+    }
   }
   out.flank_bins = static_cast<int>(n);
   const double denom = n * srr - sr * sr;

@@ -66,6 +66,7 @@ struct PileScene3 {
   std::vector<BodyState3> release;
   std::vector<double> release_time;
   double nozzle_height = 0.0;  ///< heap: m
+  double pour_speed = 0.0;     ///< heap: m/s downwards at release, besides the random velocity
   Eigen::Vector3d bounds_lo = Eigen::Vector3d::Zero();  ///< m, a box that holds the run
   Eigen::Vector3d bounds_hi = Eigen::Vector3d::Zero();
   /// The same bodies and bounds as a DropScene3 (for factories that take one).
@@ -120,20 +121,23 @@ void rotated_extent(const std::vector<Eigen::Vector3d>& points, const Eigen::Qua
 
 /// The heap's angle of repose and height from the final centres (x, y, z), m.
 ///  - axis: the centres' mean (x, y);
-///  - profile: radial bins of width `bin` (m) about the axis; each bin's top is its highest
-///    centre (r_k, z_k);
-///  - flank: the bins from the one with the highest top outward, up to (without) the first bin
-///    that is empty or whose top is less than `toe` above the lowest centre of all (the bodies
-///    lying on the ground around the heap's foot);
-///  - slope: least squares z = a + b r over the flank's tops, angle = atan(-b) in degrees
-///    (0 when the flank has fewer than 2 bins: a heap one layer high has no slope);
+///  - profile: the plane about the axis cut into `sectors` equal angular sectors and, in each,
+///    radial bins of width `bin` (m); each cell's top is its highest centre (r, z);
+///  - flank of a sector: its cells from the one with the highest top outward, up to (without)
+///    the first that is empty or whose top is less than `toe` above the lowest centre of all
+///    (the bodies lying on the ground around the heap's foot);
+///  - slope: least squares z = a + b r over the tops of every sector's flank together,
+///    angle = atan(-b) in degrees (0 with fewer than 2 tops: a heap one layer high has no
+///    slope). The sectors' profiles are read from the same heap, so a heap that is steeper on
+///    one side than the other weighs both, and the fit has `sectors` times the points of one
+///    radial profile (a heap of a hundred bodies has only a few bins along its flank);
 ///  - height: the highest centre, m.
 struct HeapProfile {
   double angle_deg = 0.0;  ///< angle of repose, degrees
   double height = 0.0;     ///< m
-  int flank_bins = 0;      ///< bins fitted
+  int flank_bins = 0;      ///< cells fitted
 };
-HeapProfile heap_profile(const std::vector<Eigen::Vector3d>& centres, double bin, double toe);
+HeapProfile heap_profile(const std::vector<Eigen::Vector3d>& centres, double bin, double toe, int sectors = 8);
 
 /// The bin's fill height and packing fraction from the final centre heights z_i (m):
 ///  - fill height H = 2 mean(z_i): the bodies fill [0, H] and, filled evenly, their centres'
