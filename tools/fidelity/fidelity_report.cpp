@@ -456,7 +456,7 @@ void register_fidelity_commands(CLI::App& app)
       "fidelity",
       std::string("Accuracy against speed: every method's single drops (and piles) against Bullet with the full "
                   "mesh, as distances between distributions with bootstrap intervals and a noise floor.\n\n") +
-          fidelity_definitions() + "\n" + summary_error_definition());
+          fidelity_definitions() + "\n" + summary_error_definition() + "\n\n" + scenes_definitions());
   cmd->add_option("--shape", opts->shape, "bunny, box or lshape (a compiled table)")
       ->check(CLI::IsMember({"bunny", "box", "lshape"}));
   cmd->add_option("--mesh", opts->mesh, "OBJ of a shape without a compiled table (Bullet full: GImpact of it; needs --table; statistical, "
