@@ -133,6 +133,7 @@ public:
   std::size_t body_count() const override { return world_->size(); }
   scenes::BodyState3 body_state(std::size_t i) const override { return world_->state(i); }
   bool body_asleep(std::size_t i) const override { return world_->asleep(i); }
+  void place_body(std::size_t i, const scenes::BodyState3& s) override { world_->set_state(i, s); }
   EndState end_state() const override
   {
     EndState e;

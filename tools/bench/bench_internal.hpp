@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,14 @@ public:
   {
     (void)i;
     return false;
+  }
+  /// Moves body i to state `s` and wakes it (a body poured during a run); between steps.
+  /// Throws std::logic_error where a method does not support it.
+  virtual void place_body(std::size_t i, const scenes::BodyState3& s)
+  {
+    (void)i;
+    (void)s;
+    throw std::logic_error("place_body: not supported by this method");
   }
   /// statsim: sampled responses applied so far (World::statistical_response_count); 0 elsewhere.
   virtual std::uint64_t statistical_responses() const { return 0; }
@@ -166,9 +175,10 @@ struct StatsimVariant {
   bool independent_pairs = false;  ///< WorldDef::pair_response = independent (default: momentum)
 };
 /// A statsim world with any signature (e.g. one loaded at run time); `sig`'s storage must outlive it.
+/// `walls`: static planes besides the ground (at most 7).
 std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mass, const scenes::DropScene3& scene,
                                          std::uint64_t seed, double dt, const std::string& broad_phase,
-                                         const StatsimVariant& variant);
+                                         const StatsimVariant& variant, const std::vector<bullet::Plane>& walls = {});
 /// `broad_phase`: "" = the runtime's default, "grid" or "sap" (sweep-and-prune).
 std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
                                    const std::string& broad_phase);

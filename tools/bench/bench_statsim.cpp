@@ -63,6 +63,7 @@ void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::Bod
   b.angular_velocity = s.angular_velocity.cast<Scalar>();
   b.shape = shape;
   b.mass = static_cast<Scalar>(mass);
+  b.asleep = s.asleep;
   const Added<BodyId> added = world.add_body(b);
   if (!added.ok()) throw std::runtime_error(std::string("statsim add_body: ") + to_string(added.status));
 }
@@ -85,11 +86,13 @@ void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::Bod
 template <int D, std::uint32_t Cap>
 class StatsimSim final : public Sim {
 public:
-  using WorldT = World<D, Cap, 4, Cap * kPairsPerBody, 2>;
+  // Planes: the ground and up to 7 more (the bin scene's four walls).
+  using WorldT = World<D, Cap, 8, Cap * kPairsPerBody, 2>;
 
   template <class Scene>
   StatsimSim(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed, double dt,
-             const std::string& broad_phase, const StatsimVariant& variant = {})
+             const std::string& broad_phase, const StatsimVariant& variant = {},
+             const std::vector<bullet::Plane>& walls = {})
       : dt_(static_cast<Scalar>(dt))
   {
     WorldDef<D> def;
@@ -104,6 +107,10 @@ public:
     if (!shape.ok()) throw std::runtime_error(std::string("statsim add_shape: ") + to_string(shape.status));
     if (!world_->add_plane(Space<D>::Vec::Unit(Space<D>::up_axis), 0).ok())
       throw std::runtime_error("statsim add_plane failed");
+    if constexpr (D == 3)
+      for (const bullet::Plane& p : walls)
+        if (!world_->add_plane(p.normal.cast<Scalar>(), static_cast<Scalar>(p.offset)).ok())
+          throw std::runtime_error("statsim add_plane (wall) failed");
     for (const auto& s : scene.bodies) add_body<D>(*world_, shape.id, mass, s);
   }
   void step() override
@@ -142,6 +149,17 @@ public:
   {
     return world_->body(static_cast<BodyId>(i)).state == MotionState::asleep;
   }
+  void place_body(std::size_t i, const scenes::BodyState3& s) override
+  {
+    if constexpr (D == 3) {
+      const BodyId id = static_cast<BodyId>(i);
+      const Status a = world_->set_transform(id, s.position.cast<Scalar>(), s.orientation.cast<Scalar>().normalized());
+      const Status b = world_->set_velocity(id, s.linear_velocity.cast<Scalar>(), s.angular_velocity.cast<Scalar>());
+      if (a != Status::ok || b != Status::ok) throw std::runtime_error("statsim place_body failed");
+    } else {
+      Sim::place_body(i, s);
+    }
+  }
   std::uint64_t statistical_responses() const override { return world_->statistical_response_count(); }
   std::uint64_t energy_clamps() const override { return world_->energy_clamp_count(); }
   std::string warning() const override
@@ -159,15 +177,16 @@ private:
 
 template <int D, class Scene>
 std::unique_ptr<Sim> make_sized(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed,
-                                double dt, const std::string& broad_phase, const StatsimVariant& v = {})
+                                double dt, const std::string& broad_phase, const StatsimVariant& v = {},
+                                const std::vector<bullet::Plane>& w = {})
 {
   const std::size_t n = scene.bodies.size();
-  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, mass, scene, seed, dt, broad_phase, v);
-  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, mass, scene, seed, dt, broad_phase, v);
-  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, mass, scene, seed, dt, broad_phase, v);
-  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, mass, scene, seed, dt, broad_phase, v);
-  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, mass, scene, seed, dt, broad_phase, v);
-  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, mass, scene, seed, dt, broad_phase, v);
+  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, mass, scene, seed, dt, broad_phase, v, w);
+  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, mass, scene, seed, dt, broad_phase, v, w);
+  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, mass, scene, seed, dt, broad_phase, v, w);
+  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, mass, scene, seed, dt, broad_phase, v, w);
+  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, mass, scene, seed, dt, broad_phase, v, w);
+  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, mass, scene, seed, dt, broad_phase, v, w);
   throw std::runtime_error("statsim bench worlds hold at most " + std::to_string(kCapacity) + " bodies");
 }
 
@@ -228,9 +247,9 @@ bool statsim_table3(const std::string& shape, SignatureView<3>& out)
 
 std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mass, const scenes::DropScene3& scene,
                                          std::uint64_t seed, double dt, const std::string& broad_phase,
-                                         const StatsimVariant& variant)
+                                         const StatsimVariant& variant, const std::vector<bullet::Plane>& walls)
 {
-  return make_sized<3>(sig, mass, scene, seed, dt, broad_phase, variant);
+  return make_sized<3>(sig, mass, scene, seed, dt, broad_phase, variant, walls);
 }
 
 std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,

@@ -205,6 +205,8 @@ DropWorld::DropWorld(const DropBody& body, const std::vector<scenes::BodyState3>
     rb->setLinearVelocity(to_bt(s.linear_velocity));
     rb->setAngularVelocity(to_bt(s.angular_velocity));
     if (!settings.sleeping) rb->setActivationState(DISABLE_DEACTIVATION);
+    // A sleeping body is neither integrated nor pulled by gravity until something wakes it.
+    if (s.asleep) rb->setActivationState(ISLAND_SLEEPING);
     m.world->addRigidBody(rb.get());
     m.bodies.push_back(std::move(rb));
   }
@@ -244,6 +246,16 @@ scenes::BodyState3 DropWorld::state(std::size_t i) const
 bool DropWorld::asleep(std::size_t i) const
 {
   return impl_->bodies[i]->getActivationState() == ISLAND_SLEEPING;
+}
+
+void DropWorld::set_state(std::size_t i, const scenes::BodyState3& s)
+{
+  btRigidBody& b = *impl_->bodies[i];
+  const Eigen::Quaterniond& q = s.orientation;
+  b.setCenterOfMassTransform(btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), to_bt(s.position)));
+  b.setLinearVelocity(to_bt(s.linear_velocity));
+  b.setAngularVelocity(to_bt(s.angular_velocity));
+  b.activate(true);
 }
 
 std::size_t DropWorld::asleep_count() const

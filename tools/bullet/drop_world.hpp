@@ -114,6 +114,8 @@ public:
   /// Body i now: centre of mass, orientation (body to world), velocities in the world frame.
   scenes::BodyState3 state(std::size_t i) const;
   bool asleep(std::size_t i) const;
+  /// Moves body i to `s` (centre of mass, orientation, velocities) and wakes it.
+  void set_state(std::size_t i, const scenes::BodyState3& s);
   std::size_t asleep_count() const;
   /// Contact manifolds holding at least one point (touching pairs, planes included).
   std::size_t touching_pairs() const;

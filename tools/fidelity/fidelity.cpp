@@ -80,6 +80,8 @@
 #include "mesh/mesh.hpp"
 #include "ref3d/reference.hpp"
 #include "ref3d/signature_json.hpp"
+#include "scenes/frames.hpp"
+#include "scenes/piles.hpp"
 #include "scenes/scenes.hpp"
 #include "statsim/signature.hpp"
 #include "statsim/world3.hpp"
@@ -118,6 +120,13 @@ std::uint64_t mix(std::uint64_t seed, std::uint64_t r)
 }
 
 }  // namespace
+
+std::vector<SceneMetric> scene_metrics(const std::string& kind)
+{
+  if (kind == "heap") return {{"angle_deg", "deg", false}, {"height", "m", true}};
+  if (kind == "bin") return {{"fill_height", "m", true}, {"packing", "", true}};
+  return {{"held", "", false}, {"overlap", "mm", false}};
+}
 
 std::vector<std::string> default_methods()
 {
@@ -175,6 +184,30 @@ const char* fidelity_definitions()
          "pile centroid / reference mean, W1 of centre heights / reference mean, rest_tvd pooled over bodies.\n"
          "Intervals: percentile bootstrap, 200 resamples of both samples (piles: seeds), 90%. step_ms: thread CPU "
          "time per step on the benchmark scene (drop_scene3, --bench-n bodies, --bench-steps steps at 1/60 s).";
+}
+
+const char* scenes_definitions()
+{
+  return "Scenes (--scenes; tools/scenes/piles.hpp), seeds 1..N per sample (reference B: N+1..2N), statsim worlds "
+         "seeded per scene seed. heap: --heap-count bodies poured one every 0.1 s, in turn from the 4 corners of a "
+         "square of side 2.1 R at (1.5 + 0.75 N^(1/3)) 2.1 R above the origin, 1 m/s downwards, random orientations "
+         "(waiting asleep far above until released); bin: --bin-count bodies in a "
+         "lattice of --bin-cells x --bin-cells cells of 2.1 R between four wall planes, layer by layer; both run "
+         "until every body rests (asleep, or slower than 0.01 m/s for 0.5 s) or --time-limit (the heap: after its last "
+         "release). column, wall: "
+         "--column-height bodies, or --wall-columns columns of --wall-height, in a rest pose (the first box's "
+         "faces along the world axes), touching, no velocity; measured after --stack-time s.\n"
+         "angle_deg: 8 angular sectors and radial bins of width R about the centres' mean (x, y); each cell's top is "
+         "its highest centre; least squares z = a + b r over the tops of every sector from its highest cell outward, "
+         "up to its first empty cell or first top less than R/2 above the lowest centre; atan(-b) in degrees (0 with "
+         "fewer than 2 tops). height: "
+         "the highest centre, m. fill_height: twice the mean centre height, m. packing: N V / (A fill_height), V the "
+         "mesh's volume, A the bin's floor area. held: the highest centre's height over the highest placed centre's "
+         "(1: the true height). overlap: deepest penetration between boxes of different bodies (separating axis "
+         "test on the shape's boxes) or of a box corner below the ground, mm. all asleep: share of runs with every body asleep at the end (the engine's "
+         "sleep state; Bullet: deactivated).\n"
+         "Distances: the mean over seeds of the method minus reference A's (relative distances divided by A's "
+         "mean); 90% percentile bootstrap intervals over resampled seeds; noise floor: reference B against A.";
 }
 
 // ---- the end of the first collision -------------------------------------------------------------
@@ -390,6 +423,18 @@ void validate(const FidelityOptions& o)
   if (o.bench_steps < 1) bad("--bench-steps must be at least 1");
   if (o.bootstrap < 0) bad("--bootstrap must be >= 0");
   if (o.reference != "gather" && o.reference != "bench") bad("--reference must be gather or bench");
+  for (const std::string& k : o.scenes)
+    if (k != "heap" && k != "bin" && k != "stack" && k != "column" && k != "wall")
+      bad("--scenes takes heap, bin, stack, column, wall (got '" + k + "')");
+  if (!o.drops && o.scenes.empty()) bad("--scenes-only needs --scenes");
+  if (o.scene_seeds < 1) bad("--scene-seeds must be at least 1");
+  if (o.heap_count < 1 || o.heap_count > 16384) bad("--heap-count must be in [1, 16384]");
+  if (o.bin_count < 1 || o.bin_count > 16384) bad("--bin-count must be in [1, 16384]");
+  if (o.bin_cells < 1 || o.bin_cells > 64) bad("--bin-cells must be in [1, 64]");
+  if (o.column_height < 1 || o.column_height > 1000) bad("--column-height must be in [1, 1000]");
+  if (o.wall_columns < 1 || o.wall_columns > 100) bad("--wall-columns must be in [1, 100]");
+  if (o.wall_height < 1 || o.wall_height > 1000) bad("--wall-height must be in [1, 1000]");
+  if (!(o.stack_time > 0) || o.stack_time > 600) bad("--stack-time must be in (0, 600] s");
   if (!o.mesh.empty() && o.tables.empty()) bad("--mesh needs --table NAME=FILE.json (the shape has no compiled table)");
   for (const auto& t : o.tables)
     if (t.first.empty() || t.second.empty()) bad("--table takes NAME=FILE.json");
@@ -852,6 +897,301 @@ void run_samples(const char* label, std::size_t samples, std::size_t per_sample,
   }
 }
 
+
+// ---- pile scenes (--scenes) ------------------------------------------------------------------------
+
+std::vector<std::string> expand_scenes(const std::vector<std::string>& names)
+{
+  std::vector<std::string> out;
+  auto add = [&](const std::string& k) {
+    if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+  };
+  for (const std::string& n : names) {
+    if (n == "stack") add("column"), add("wall");
+    else add(n);
+  }
+  return out;
+}
+
+// A stack's pose for a shape built of boxes: the first box's axes along the world's (a box face
+// down, the L-shape flat on its large face). The L-shape's body frame is its principal frame;
+// a box is symmetric about its own axes, so turning the frame into a proper rotation by flipping
+// one axis keeps every face axis-aligned.
+Eigen::Quaterniond stack_orientation(const bench::Body3& body)
+{
+  if (body.boxes.empty())
+    throw std::invalid_argument("the column and the wall need a shape built of boxes (box, lshape), not " + body.shape);
+  Eigen::Matrix3d q = body.boxes.front().rotation.transpose();
+  if (q.determinant() < 0) q.row(0) *= -1;
+  return Eigen::Quaterniond(q).normalized();
+}
+
+// Volume of the closed triangle mesh (divergence theorem: the sum of the signed volumes of the
+// tetrahedra from the origin to each triangle, a . (b x c) / 6).
+double mesh_volume(const bench::Body3& body)
+{
+  double v = 0;
+  for (std::size_t t = 0; t + 2 < body.full_indices.size(); t += 3) {
+    const Eigen::Vector3d& a = body.full_vertices[static_cast<std::size_t>(body.full_indices[t])];
+    const Eigen::Vector3d& b = body.full_vertices[static_cast<std::size_t>(body.full_indices[t + 1])];
+    const Eigen::Vector3d& c = body.full_vertices[static_cast<std::size_t>(body.full_indices[t + 2])];
+    v += a.dot(b.cross(c));
+  }
+  return std::fabs(v) / 6.0;
+}
+
+scenes::PileScene3 make_scene(const Setup& setup, const FidelityOptions& o, const std::string& kind,
+                              std::uint64_t seed)
+{
+  if (kind == "heap") {
+    scenes::HeapOptions h;
+    h.count = o.heap_count;
+    h.bounding_radius = setup.radius;
+    h.seed = seed;
+    return scenes::heap_scene(h);
+  }
+  if (kind == "bin") {
+    scenes::BinOptions b;
+    b.count = o.bin_count;
+    b.bounding_radius = setup.radius;
+    b.seed = seed;
+    b.cells = o.bin_cells;
+    return scenes::bin_scene(b);
+  }
+  scenes::StackOptions s;
+  s.orientation = stack_orientation(setup.body);
+  s.height = kind == "column" ? o.column_height : o.wall_height;
+  s.columns = kind == "column" ? 1 : o.wall_columns;
+  scenes::rotated_extent(setup.body.full_vertices, s.orientation, s.lo, s.hi);
+  return scenes::stack_scene(s);
+}
+
+std::string describe_scene(const scenes::PileScene3& sc, const FidelityOptions& o)
+{
+  char b[400];
+  if (sc.kind == "heap")
+    std::snprintf(b, sizeof b,
+                  "heap: %zu bodies poured one every %.3g s from 4 points %.3g m apart at %.3g m above the origin, "
+                  "%.3g m/s downwards, onto the ground; runs end when all rest after the last release or %.3g s after it",
+                  sc.bodies.size(), sc.release_time.size() > 1 ? sc.release_time[1] : 0.0, sc.cell, sc.nozzle_height,
+                  sc.pour_speed, o.time_limit);
+  else if (sc.kind == "bin")
+    std::snprintf(b, sizeof b,
+                  "bin: %zu bodies in a square bin of inner side %.3g m (%d x %d cells of %.3g m, layers from %.3g m), "
+                  "walls and ground planes; runs end when all rest or at %.3g s",
+                  sc.bodies.size(), 2 * sc.bin_half_width, o.bin_cells, o.bin_cells, sc.cell, 1.5 * sc.cell,
+                  o.time_limit);
+  else
+    std::snprintf(b, sizeof b,
+                  "%s: %d column(s) of %d bodies in a rest pose, touching (pitch %.4g m, column width %.4g m, top "
+                  "centre placed at %.4g m), no velocity; measured after %.3g s",
+                  sc.kind.c_str(), sc.columns, sc.height, sc.pitch, sc.width, sc.bodies.back().position.z(),
+                  o.stack_time);
+  return b;
+}
+
+struct SceneOutcome {
+  SceneRun run;
+  std::vector<scenes::BodyState3> states;  // final
+  std::vector<bool> asleep;
+};
+
+SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::PileScene3& sc,
+                       const FidelityOptions& o, double dt, std::uint64_t world_seed, double volume)
+{
+  const scenes::DropScene3 drop = sc.as_drop_scene();
+  std::vector<bullet::Plane> planes;
+  for (const scenes::ScenePlane& p : sc.planes) planes.push_back({p.normal, p.offset});
+  std::unique_ptr<bench::Sim> sim;
+  if (m.bullet) {
+    // dbvt: the sweep-and-prune broad phase holds N + 2 handles, too few with the bin's walls.
+    bullet::DropSettings s = bench::bullet_drop_settings(setup.body, m.bullet_method, "dbvt", drop);
+    s.planes = planes;
+    sim = bench::make_bullet(bench::make_bullet_shapes(setup.body), m.bullet_method, s, sc.bodies, dt);
+  } else {
+    // The statsim world adds the ground itself; the rest are walls.
+    const std::vector<bullet::Plane> walls(planes.begin() + 1, planes.end());
+    sim = bench::make_statsim3_table(m.table, setup.body.mass, drop, world_seed, dt, "", m.variant, walls);
+  }
+  const bool stack = sc.kind == "column" || sc.kind == "wall";
+  // The heap's time limit counts from its last release.
+  const double limit = stack ? o.stack_time : o.time_limit + (sc.release_time.empty() ? 0.0 : sc.release_time.back());
+  const std::size_t n = sc.bodies.size();
+  std::vector<double> quiet_since(n, -1);
+  const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));
+  SceneOutcome out;
+  out.run.time_limited = !stack;
+  out.states.resize(n);
+  double t = 0;
+  std::size_t released = 0;  // heap: bodies are released in order
+  for (long k = 1; k <= steps; ++k) {
+    for (; released < sc.release.size() && sc.release_time[released] <= t + 1e-9; ++released)
+      sim->place_body(released, sc.release[released]);
+    sim->step();
+    t = static_cast<double>(k) * dt;
+    if (stack || released < sc.release.size()) continue;
+    bool all = true;
+    for (std::size_t i = 0; i < n; ++i) {
+      const scenes::BodyState3 s = sim->body_state(i);
+      if (speed(s, setup.radius) < kQuietSpeed) {
+        if (quiet_since[i] < 0) quiet_since[i] = t;
+      } else {
+        quiet_since[i] = -1;
+      }
+      all = all && (sim->body_asleep(i) || (quiet_since[i] >= 0 && t - quiet_since[i] >= kQuietTime - 1e-9));
+    }
+    if (all) {
+      out.run.time_limited = false;
+      break;
+    }
+  }
+  out.run.seconds = t;
+  out.run.all_asleep = true;
+  std::vector<Eigen::Vector3d> centres(n);
+  out.asleep.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.states[i] = sim->body_state(i);
+    centres[i] = out.states[i].position;
+    out.asleep[i] = sim->body_asleep(i);
+    out.run.all_asleep = out.run.all_asleep && out.asleep[i];
+  }
+  if (sc.kind == "heap") {
+    const scenes::HeapProfile h = scenes::heap_profile(centres, setup.radius, 0.5 * setup.radius);
+    out.run.values = {h.angle_deg, h.height};
+  } else if (sc.kind == "bin") {
+    std::vector<double> z;
+    for (const Eigen::Vector3d& c : centres) z.push_back(c.z());
+    const double side = 2 * sc.bin_half_width;
+    const scenes::BinFill f = scenes::bin_fill(z, volume, side * side);
+    out.run.values = {f.fill_height, f.packing};
+  } else {
+    std::vector<Eigen::Quaterniond> orientations(n);
+    for (std::size_t i = 0; i < n; ++i) orientations[i] = out.states[i].orientation;
+    std::vector<scenes::SceneBox> boxes;
+    for (const bench::Body3::Box& b : setup.body.boxes) boxes.push_back({b.centre, b.rotation, b.half_extents});
+    const scenes::StackHold h = scenes::stack_hold(sc, boxes, centres, orientations);
+    out.run.values = {h.held, 1e3 * h.overlap};
+  }
+  return out;
+}
+
+void write_scene_frames(const std::string& path, const std::string& shape, const SceneOutcome& r)
+{
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw std::runtime_error("cannot write " + path);
+  scenes::write_frames_header(f);
+  for (std::size_t i = 0; i < r.states.size(); ++i)
+    scenes::write_frame_row(f, 0, r.run.seconds, static_cast<std::uint32_t>(i), shape.c_str(), r.states[i].position,
+                            r.states[i].orientation, r.asleep[i] ? 2 : 0, 0.0);
+  if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + path);
+}
+
+double metric_mean(const std::vector<SceneRun>& runs, std::size_t k)
+{
+  double s = 0;
+  for (const SceneRun& r : runs) s += r.values[k];
+  return runs.empty() ? 0.0 : s / static_cast<double>(runs.size());
+}
+
+double metric_distance(const SceneMetric& m, const std::vector<SceneRun>& a, const std::vector<SceneRun>& ref,
+                       std::size_t k)
+{
+  const double d = metric_mean(a, k) - metric_mean(ref, k);
+  if (!m.relative) return d;
+  const double r = metric_mean(ref, k);
+  return r != 0 ? d / r : 0.0;
+}
+
+double asleep_share(const std::vector<SceneRun>& runs)
+{
+  double n = 0;
+  for (const SceneRun& r : runs) n += r.all_asleep;
+  return runs.empty() ? 0.0 : n / static_cast<double>(runs.size());
+}
+
+// Means (with intervals over resampled seeds) and, against `ref`, the distances.
+void summarise(SceneSample& s, const std::vector<SceneMetric>& metrics, const std::vector<SceneRun>* ref,
+               int resamples)
+{
+  const std::size_t n = s.runs.size();
+  auto own = [&](auto stat) {
+    return bootstrap(
+        n, n, [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>&) { return stat(pick(s.runs, ia)); },
+        resamples);
+  };
+  s.means.clear();
+  s.distances.clear();
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    s.means.push_back({metric_mean(s.runs, k), own([k](const std::vector<SceneRun>& r) { return metric_mean(r, k); })});
+    if (!ref) continue;
+    const SceneMetric& m = metrics[k];
+    s.distances.push_back({metric_distance(m, s.runs, *ref, k),
+                           resampled(s.runs, *ref,
+                                     [&](const std::vector<SceneRun>& a, const std::vector<SceneRun>& b) {
+                                       return metric_distance(m, a, b, k);
+                                     },
+                                     [](double x) { return x; }, resamples)});
+  }
+  s.asleep = {asleep_share(s.runs), own([](const std::vector<SceneRun>& r) { return asleep_share(r); })};
+}
+
+std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o, unsigned threads)
+{
+  std::vector<SceneResult> results;
+  const double volume = mesh_volume(setup.body);
+  const std::size_t seeds = static_cast<std::size_t>(o.scene_seeds);
+  const std::size_t samples = 2 + setup.methods.size();
+  MethodSpec ref;
+  ref.name = "reference";
+  ref.bullet = true;
+  ref.bullet_method = "full";
+  for (const std::string& kind : expand_scenes(o.scenes)) {
+    SceneResult res;
+    res.kind = kind;
+    res.metrics = scene_metrics(kind);
+    res.description = describe_scene(make_scene(setup, o, kind, 1), o);
+    Progress progress(("fidelity: " + kind).c_str(), samples * seeds, o.progress);
+    // Job j: sample j % samples, seed index j / samples (the expensive reference runs spread out).
+    const std::vector<SceneOutcome> all = parallel_map(
+        samples * seeds,
+        [&](std::size_t job) {
+          const std::size_t sample = job % samples, k = job / samples;
+          const std::uint64_t seed = 1 + k + (sample == 1 ? seeds : 0);
+          const MethodSpec& m = sample < 2 ? ref : setup.methods[sample - 2];
+          const double dt = sample < 2 ? o.pile_reference_dt : o.dt;
+          SceneOutcome r = run_scene(setup, m, make_scene(setup, o, kind, seed), o, dt, mix(o.seed, seed), volume);
+          progress.add();
+          if (k != 0 || o.scene_frames.empty()) r.states.clear();
+          return r;
+        },
+        threads);
+    res.reference.name = "reference";
+    res.reference.dt = o.pile_reference_dt;
+    res.reference_b.name = "reference_b";
+    res.reference_b.dt = o.pile_reference_dt;
+    res.methods.resize(setup.methods.size());
+    for (std::size_t i = 0; i < setup.methods.size(); ++i) {
+      res.methods[i].name = setup.methods[i].name;
+      res.methods[i].dt = o.dt;
+    }
+    for (std::size_t job = 0; job < all.size(); ++job) {
+      const std::size_t sample = job % samples;
+      SceneSample& s = sample == 0 ? res.reference : sample == 1 ? res.reference_b : res.methods[sample - 2];
+      s.runs.push_back(all[job].run);
+      if (!all[job].states.empty()) {
+        const std::string file = o.scene_frames + "/" + kind + "_" + (sample == 0 ? std::string("reference") : s.name) +
+                                 ".csv";
+        if (sample != 1) write_scene_frames(file, setup.body.shape, all[job]);
+      }
+    }
+    summarise(res.reference, res.metrics, nullptr, o.bootstrap);
+    summarise(res.reference_b, res.metrics, &res.reference.runs, o.bootstrap);
+    for (SceneSample& s : res.methods) summarise(s, res.metrics, &res.reference.runs, o.bootstrap);
+    results.push_back(std::move(res));
+  }
+  return results;
+}
+
 }  // namespace
 
 FidelityResult run_fidelity(const FidelityOptions& options)
@@ -876,11 +1216,14 @@ FidelityResult run_fidelity(const FidelityOptions& options)
   res.pose_labels.push_back("other");
   const int configs = static_cast<int>(res.pose_labels.size());
   const bool gather_ref = options.reference == "gather";
-  if (gather_ref) {
+  if (!options.drops) {
+    for (const std::string& line : bench::bullet_settings(setup->body))
+      res.settings.push_back("scenes (statsim bench's settings): " + line);
+  } else if (gather_ref) {
     res.settings = gather_settings_lines(*setup->model, setup->reference_settings);
-    if (options.piles)
+    if (options.piles || !options.scenes.empty())
       for (const std::string& line : bench::bullet_settings(setup->body))
-        res.settings.push_back("piles (statsim bench's settings): " + line);
+        res.settings.push_back("piles and scenes (statsim bench's settings): " + line);
   } else {
     res.settings = bench::bullet_settings(setup->body);
   }
@@ -906,15 +1249,17 @@ FidelityResult run_fidelity(const FidelityOptions& options)
   const std::size_t samples = 2 + setup->methods.size();
   const unsigned threads = resolve_thread_count(options.threads);
   res.methods.resize(setup->methods.size());
-  run_samples(
-      "fidelity: single drops", samples, runs, threads, options.progress, res,
-      [&](std::size_t sample, std::size_t r) {
-        const MethodSpec& m = sample < 2 ? ref : setup->methods[sample - 2];
-        const double dt = sample < 2 ? options.reference_dt : options.dt;
-        const std::uint64_t index = r + (sample == 1 ? kSampleB : 0);
-        return run_single(*setup, m, mix(options.seed, index), dt, options.time_limit);
-      },
-      [](MethodResult& mr, const DropRun& d) { mr.drops.push_back(d); });
+  if (options.drops) {
+    run_samples(
+        "fidelity: single drops", samples, runs, threads, options.progress, res,
+        [&](std::size_t sample, std::size_t r) {
+          const MethodSpec& m = sample < 2 ? ref : setup->methods[sample - 2];
+          const double dt = sample < 2 ? options.reference_dt : options.dt;
+          const std::uint64_t index = r + (sample == 1 ? kSampleB : 0);
+          return run_single(*setup, m, mix(options.seed, index), dt, options.time_limit);
+        },
+        [](MethodResult& mr, const DropRun& d) { mr.drops.push_back(d); });
+  }
   for (std::size_t i = 0; i < setup->methods.size(); ++i) {
     res.methods[i].name = setup->methods[i].name;
     res.methods[i].description = setup->methods[i].description;
@@ -922,7 +1267,7 @@ FidelityResult run_fidelity(const FidelityOptions& options)
     res.methods[i].table_bytes = setup->methods[i].table_bytes;
   }
 
-  if (options.piles) {
+  if (options.drops && options.piles) {
     const std::size_t seeds = static_cast<std::size_t>(options.pile_seeds);
     run_samples(
         "fidelity: piles", samples, seeds, threads, options.progress, res,
@@ -935,7 +1280,7 @@ FidelityResult run_fidelity(const FidelityOptions& options)
         [](MethodResult& mr, const PileRun& p) { mr.piles.push_back(p); });
   }
 
-  {
+  if (options.drops) {
     Progress progress("fidelity: bootstrap", samples - 1, options.progress);
     res.noise_floor = compare(res.reference_b.drops, res.reference.drops, res.reference_b.piles, res.reference.piles,
                               configs, options.bootstrap);
@@ -952,7 +1297,9 @@ FidelityResult run_fidelity(const FidelityOptions& options)
     for (std::size_t i = 0; i < d.size(); ++i) res.methods[i].d = d[i];
   }
 
-  if (options.timing) {
+  if (!options.scenes.empty()) res.scenes = run_scenes(*setup, options, threads);
+
+  if (options.drops && options.timing) {
     // One method at a time on this thread: thread CPU time is what the benchmark reports.
     Progress progress("fidelity: step time", setup->methods.size(), options.progress);
     for (std::size_t i = 0; i < setup->methods.size(); ++i) {

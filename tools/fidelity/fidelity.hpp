@@ -44,6 +44,19 @@ struct FidelityOptions {
   int bootstrap = 200;               ///< resamples per interval
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes
   bool progress = true;
+  /// Pile scenes (tools/scenes/piles.hpp) to run: heap, bin, column, wall ("stack": column and
+  /// wall). Each against Bullet full at pile_reference_dt with statsim bench's settings.
+  std::vector<std::string> scenes;
+  bool drops = true;                 ///< false: no single drops, piles or step time (scenes only)
+  int scene_seeds = 10;              ///< scene seeds 1..N per sample (reference floor: N+1..2N)
+  int heap_count = 60;               ///< bodies of the heap
+  int bin_count = 60;                ///< bodies of the bin
+  int bin_cells = 4;                 ///< lattice cells along the bin's side
+  int column_height = 10;            ///< bodies of the column
+  int wall_columns = 4;              ///< columns of the wall
+  int wall_height = 5;               ///< bodies per column of the wall
+  double stack_time = 3.0;           ///< s, simulated time of the column and the wall
+  std::string scene_frames;          ///< directory: final states of seed 1 as frame files; empty: none
 };
 
 /// Method names used when none are given: full, low, spheres7, sphere, statistical,
@@ -152,6 +165,41 @@ struct MethodResult {
   long long table_bytes = -1; ///< -1: no table
 };
 
+/// Outcome of one run of a pile scene.
+struct SceneRun {
+  std::vector<double> values;  ///< the scene's measurements, in scene_metrics() order
+  bool all_asleep = false;     ///< every body asleep at the end (the engine's sleep state)
+  bool time_limited = false;   ///< heap, bin: not every body rested by the time limit
+  double seconds = 0;          ///< simulated time of the run, s
+};
+
+/// A measurement of a scene and how its distance to the reference is taken.
+struct SceneMetric {
+  std::string name;    ///< e.g. "angle_deg"
+  std::string unit;    ///< of the values
+  bool relative;       ///< distance (mean - mean_ref) / mean_ref; else mean - mean_ref in the unit
+};
+/// The measurements of a scene kind (heap, bin, column, wall).
+std::vector<SceneMetric> scene_metrics(const std::string& kind);
+
+/// One sample's runs of a scene and, for the methods, the distances to the reference sample A.
+struct SceneSample {
+  std::string name;                 ///< method, "reference" or "reference_b"
+  double dt = 0;
+  std::vector<SceneRun> runs;       ///< one per seed
+  std::vector<Distance> means;      ///< per metric: the mean over seeds and its 90% interval
+  std::vector<Distance> distances;  ///< per metric: against reference A (the floor: B against A)
+  Distance asleep;                  ///< share of runs with every body asleep at the end
+};
+
+struct SceneResult {
+  std::string kind;
+  std::string description;          ///< the scene's set-up in one line
+  std::vector<SceneMetric> metrics;
+  SceneSample reference, reference_b;
+  std::vector<SceneSample> methods;
+};
+
 struct FidelityResult {
   FidelityOptions options;
   std::string shape;                  ///< name of the body
@@ -161,6 +209,7 @@ struct FidelityResult {
   MethodResult reference_b;           ///< sample B (noise floor)
   Distances noise_floor;              ///< B against A
   std::vector<MethodResult> methods;
+  std::vector<SceneResult> scenes;    ///< --scenes
   std::vector<std::string> settings;  ///< engine settings, one per line
   std::string command;
   double seconds = 0;                 ///< wall time of the whole run
@@ -173,6 +222,8 @@ double summary_error(double rest_tvd, double rest_height_err, double travel_w1, 
 const char* summary_error_definition();
 /// The definitions of every measurement, for --help and the JSON.
 const char* fidelity_definitions();
+/// The definitions of the pile scenes' measurements (--scenes), for --help and the JSON.
+const char* scenes_definitions();
 
 /// Distances of `method` against `reference` (both DropRun samples over the same rest
 /// configurations, `configs` of them including "other"); piles when both have piles.
@@ -187,6 +238,8 @@ FidelityResult run_fidelity(const FidelityOptions& options);
 
 std::string fidelity_json(const FidelityResult& result);
 std::string fidelity_table(const FidelityResult& result);
+/// The scenes' tables (part of fidelity_table()).
+std::string scenes_table(const FidelityResult& result);
 
 /// The charts of a run; an empty path draws none. Each is a PNG at the path and an SVG beside it
 /// (FILE.svg), with the noise floor marked.

@@ -73,6 +73,51 @@ ClampRate clamp_rate(const std::vector<Run>& runs)
   return c;
 }
 
+json scene_sample_json(const SceneSample& s, const std::vector<SceneMetric>& metrics)
+{
+  json j;
+  j["dt"] = s.dt;
+  json means, distances;
+  for (std::size_t k = 0; k < metrics.size(); ++k) {
+    put(means, metrics[k].name.c_str(), s.means[k]);
+    if (k < s.distances.size()) put(distances, metrics[k].name.c_str(), s.distances[k]);
+  }
+  j["means"] = means;
+  if (!s.distances.empty()) j["distances"] = distances;
+  put(j, "all_asleep_share", s.asleep);
+  json runs = json::array();
+  for (const SceneRun& r : s.runs) {
+    json x;
+    for (std::size_t k = 0; k < metrics.size(); ++k) x[metrics[k].name] = r.values[k];
+    x["all_asleep"] = r.all_asleep;
+    x["time_limited"] = r.time_limited;
+    x["seconds"] = r.seconds;
+    runs.push_back(x);
+  }
+  j["runs"] = runs;
+  return j;
+}
+
+json scenes_json(const std::vector<SceneResult>& scenes)
+{
+  json out = json::object();
+  for (const SceneResult& sc : scenes) {
+    json j;
+    j["description"] = sc.description;
+    json metrics = json::array();
+    for (const SceneMetric& m : sc.metrics)
+      metrics.push_back({{"name", m.name}, {"unit", m.unit}, {"distance", m.relative ? "relative" : "difference"}});
+    j["metrics"] = metrics;
+    j["reference"] = scene_sample_json(sc.reference, sc.metrics);
+    j["noise_floor"] = scene_sample_json(sc.reference_b, sc.metrics);
+    json methods = json::object();
+    for (const SceneSample& m : sc.methods) methods[m.name] = scene_sample_json(m, sc.metrics);
+    j["methods"] = methods;
+    out[sc.kind] = j;
+  }
+  return out;
+}
+
 json sample_json(const MethodResult& m, int configs)
 {
   json j;
@@ -140,13 +185,20 @@ std::string command_line(const FidelityOptions& o)
   c << " --runs " << o.runs << " --reference " << o.reference << " --dt " << o.dt << " --reference-dt "
     << o.reference_dt << " --time-limit "
     << o.time_limit;
-  if (o.piles)
+  if (o.piles || !o.scenes.empty())
     c << " --pile-seeds " << o.pile_seeds << " --pile-count " << o.pile_count << " --pile-reference-dt "
       << o.pile_reference_dt;
-  else
-    c << " --no-piles";
+  if (!o.piles) c << " --no-piles";
   if (o.timing) c << " --bench-n " << o.bench_n << " --bench-steps " << o.bench_steps;
   else c << " --no-timing";
+  if (!o.scenes.empty()) {
+    c << " --scenes ";
+    for (std::size_t i = 0; i < o.scenes.size(); ++i) c << (i ? "," : "") << o.scenes[i];
+    if (!o.drops) c << " --scenes-only";
+    c << " --scene-seeds " << o.scene_seeds << " --heap-count " << o.heap_count << " --bin-count " << o.bin_count
+      << " --bin-cells " << o.bin_cells << " --column-height " << o.column_height << " --wall-columns "
+      << o.wall_columns << " --wall-height " << o.wall_height << " --stack-time " << o.stack_time;
+  }
   c << " --seed " << o.seed << " --bootstrap " << o.bootstrap;
   return c.str();
 }
@@ -198,7 +250,17 @@ std::string fidelity_json(const FidelityResult& r)
                   {"bench_n", r.options.bench_n},
                   {"bench_steps", r.options.bench_steps},
                   {"seed", r.options.seed},
-                  {"bootstrap", r.options.bootstrap}};
+                  {"bootstrap", r.options.bootstrap},
+                  {"drops", r.options.drops},
+                  {"scenes", r.options.scenes},
+                  {"scene_seeds", r.options.scene_seeds},
+                  {"heap_count", r.options.heap_count},
+                  {"bin_count", r.options.bin_count},
+                  {"bin_cells", r.options.bin_cells},
+                  {"column_height", r.options.column_height},
+                  {"wall_columns", r.options.wall_columns},
+                  {"wall_height", r.options.wall_height},
+                  {"stack_time", r.options.stack_time}};
   json ref = sample_json(r.reference, configs);
   ref["method"] = "full";
   ref["reference"] = r.options.reference;
@@ -221,12 +283,59 @@ std::string fidelity_json(const FidelityResult& r)
   }
   j["methods"] = methods;
   j["noise_floor"] = distances_json(r.noise_floor);
+  if (!r.scenes.empty()) {
+    j["scenes_definitions"] = scenes_definitions();
+    j["scenes"] = scenes_json(r.scenes);
+  }
   j["seconds"] = r.seconds;
   return j.dump(2) + "\n";
 }
 
+std::string scenes_table(const FidelityResult& r)
+{
+  std::ostringstream s;
+  s << "# statsim fidelity, pile scenes: " << r.shape << " (R = " << num(r.bounding_radius, "%.4f") << " m), "
+    << r.options.scene_seeds << " seeds per sample\n\nReference: Bullet full at dt "
+    << num(r.options.pile_reference_dt, "%.5g") << " s with the settings of statsim bench; methods at dt "
+    << num(r.options.dt, "%.5g")
+    << " s. Means over the seeds and distances to reference A (relative: (mean - mean_ref) / mean_ref; else the "
+       "difference in the unit), with 90% bootstrap intervals over the seeds; the noise floor is reference B "
+       "(seeds N+1..2N) against A.\n";
+  for (const SceneResult& sc : r.scenes) {
+    s << "\n## " << sc.kind << "\n\n" << sc.description << "\n\n| sample |";
+    for (const SceneMetric& m : sc.metrics)
+      s << " " << m.name << (m.unit.empty() ? "" : " (" + m.unit + ")") << " | "
+        << (m.relative ? "relative distance" : "difference") << " |";
+    s << " all asleep | rested before the limit | mean s simulated |\n|---|";
+    for (std::size_t k = 0; k < sc.metrics.size(); ++k) s << "---|---|";
+    s << "---|---|---|\n";
+    auto row = [&](const std::string& name, const SceneSample& x) {
+      s << "| " << name << " |";
+      for (std::size_t k = 0; k < sc.metrics.size(); ++k)
+        s << " " << with_ci(x.means[k]) << " | " << (k < x.distances.size() ? with_ci(x.distances[k]) : "-") << " |";
+      double rested = 0, secs = 0;
+      for (const SceneRun& run : x.runs) rested += !run.time_limited, secs += run.seconds;
+      const double n = x.runs.empty() ? 1.0 : static_cast<double>(x.runs.size());
+      s << " " << num(x.asleep.value, "%.2f") << " | " << num(rested / n, "%.2f") << " | " << num(secs / n, "%.2f")
+        << " |\n";
+    };
+    row("reference A (Bullet full)", sc.reference);
+    for (const SceneSample& m : sc.methods) row(m.name, m);
+    row("noise floor (reference B vs A)", sc.reference_b);
+  }
+  s << "\n" << scenes_definitions() << "\n";
+  return s.str();
+}
+
 std::string fidelity_table(const FidelityResult& r)
 {
+  if (!r.options.drops) {
+    std::ostringstream w;
+    w << scenes_table(r) << "\nReference settings:\n";
+    for (const std::string& line : r.settings) w << "- " << line << "\n";
+    w << "\nWall time " << num(r.seconds, "%.1f") << " s.\n";
+    return w.str();
+  }
   std::ostringstream s;
   s << "# statsim fidelity: " << r.shape << " (R = " << num(r.bounding_radius, "%.4f") << " m), " << r.options.runs
     << " single drops per sample";
@@ -292,7 +401,9 @@ std::string fidelity_table(const FidelityResult& r)
   for (const std::string& line : r.settings) s << "- " << line << "\n";
   s << "\nRest configurations: ";
   for (std::size_t i = 0; i < r.pose_labels.size(); ++i) s << (i ? "; " : "") << i << " " << r.pose_labels[i];
-  s << "\n\n" << summary_error_definition() << "\nWall time " << num(r.seconds, "%.1f") << " s.\n";
+  s << "\n\n" << summary_error_definition() << "\n";
+  if (!r.scenes.empty()) s << "\n" << scenes_table(r);
+  s << "\nWall time " << num(r.seconds, "%.1f") << " s.\n";
   return s.str();
 }
 
@@ -333,6 +444,8 @@ void register_fidelity_commands(CLI::App& app)
   auto method_list = std::make_shared<std::string>();
   auto table_args = std::make_shared<std::vector<std::string>>();
   auto no_piles = std::make_shared<bool>(false);
+  auto scene_list = std::make_shared<std::string>();
+  auto scenes_only = std::make_shared<bool>(false);
   auto no_timing = std::make_shared<bool>(false);
   auto quiet = std::make_shared<bool>(false);
   auto replot = std::make_shared<std::string>();
@@ -343,7 +456,7 @@ void register_fidelity_commands(CLI::App& app)
       "fidelity",
       std::string("Accuracy against speed: every method's single drops (and piles) against Bullet with the full "
                   "mesh, as distances between distributions with bootstrap intervals and a noise floor.\n\n") +
-          fidelity_definitions() + "\n" + summary_error_definition());
+          fidelity_definitions() + "\n" + summary_error_definition() + "\n\n" + scenes_definitions());
   cmd->add_option("--shape", opts->shape, "bunny, box or lshape (a compiled table)")
       ->check(CLI::IsMember({"bunny", "box", "lshape"}));
   cmd->add_option("--mesh", opts->mesh, "OBJ of a shape without a compiled table (Bullet full: GImpact of it; needs --table; statistical, "
@@ -371,6 +484,24 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--pile-count", opts->pile_count, "bodies per pile")->capture_default_str();
   cmd->add_option("--pile-reference-dt", *pile_dt_text, "step of the reference in piles, s (a number or 1/N)")
       ->capture_default_str();
+  cmd->add_option("--scenes", *scene_list,
+                  "comma-separated pile scenes (tools/scenes/piles.hpp): heap, bin, stack (= column,wall), column, "
+                  "wall; against Bullet full at --pile-reference-dt with statsim bench's settings");
+  cmd->add_flag("--scenes-only", *scenes_only, "run only --scenes (no single drops, piles or step time)");
+  cmd->add_option("--scene-seeds", opts->scene_seeds, "scenes: seeds 1..N per sample (noise floor N+1..2N)")
+      ->capture_default_str();
+  cmd->add_option("--heap-count", opts->heap_count, "bodies of the heap")->capture_default_str();
+  cmd->add_option("--bin-count", opts->bin_count, "bodies of the bin")->capture_default_str();
+  cmd->add_option("--bin-cells", opts->bin_cells, "lattice cells along the bin's side (side = cells x 2.1 R)")
+      ->capture_default_str();
+  cmd->add_option("--column-height", opts->column_height, "bodies of the column")->capture_default_str();
+  cmd->add_option("--wall-columns", opts->wall_columns, "columns of the wall")->capture_default_str();
+  cmd->add_option("--wall-height", opts->wall_height, "bodies per column of the wall")->capture_default_str();
+  cmd->add_option("--stack-time", opts->stack_time, "s simulated before the column and the wall are measured")
+      ->capture_default_str();
+  cmd->add_option("--scene-frames", opts->scene_frames,
+                  "directory: the final state of seed 1 of each scene, reference A and each method, as frame files "
+                  "(KIND_METHOD.csv) for statsim render");
   cmd->add_option("--bench-n", opts->bench_n, "bodies of the step-time scene")->capture_default_str();
   cmd->add_option("--bench-steps", opts->bench_steps, "steps of the step-time scene")->capture_default_str();
   cmd->add_flag("--no-timing", *no_timing, "do not measure step_ms");
@@ -390,6 +521,13 @@ void register_fidelity_commands(CLI::App& app)
   cmd->callback([=]() {
     FidelityOptions o = *opts;
     o.piles = !*no_piles;
+    o.drops = !*scenes_only;
+    if (!scene_list->empty()) {
+      std::stringstream ss(*scene_list);
+      std::string k;
+      while (std::getline(ss, k, ','))
+        if (!k.empty()) o.scenes.push_back(k);
+    }
     o.timing = !*no_timing;
     o.progress = !*quiet;
     if (!method_list->empty()) {
@@ -420,6 +558,7 @@ void register_fidelity_commands(CLI::App& app)
       if (!json_path->empty()) ensure_writable_directory(std::filesystem::absolute(*json_path).parent_path());
       if (!chart_path->empty()) ensure_writable_directory(std::filesystem::absolute(*chart_path).parent_path());
       if (!charts_dir->empty()) ensure_writable_directory(*charts_dir);
+      if (!o.scene_frames.empty()) ensure_writable_directory(o.scene_frames);
       if (!bytes_chart_path->empty())
         ensure_writable_directory(std::filesystem::absolute(*bytes_chart_path).parent_path());
       if (charts.any()) plot::find_python();  // a missing matplotlib too

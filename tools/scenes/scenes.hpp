@@ -65,6 +65,8 @@ struct BodyState3 {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< body to world, unit
   Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();         ///< m/s
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();        ///< rad/s, world frame
+  /// Starts asleep, held where it is without gravity until moved (a body waiting to be poured).
+  bool asleep = false;
 };
 
 /// Initial state of a 2D body, SI units, world frame (y up).
