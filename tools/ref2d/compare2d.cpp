@@ -122,23 +122,7 @@ MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, cons
   m.method = "box2d";
   b2World world(b2Vec2(0.0f, -9.81f));
   world.SetAllowSleeping(true);
-  Surface surface;
-  surface.friction = sig.material.friction;
-  surface.restitution = sig.material.restitution;
-  surface.restitution_threshold = sig.restitution_threshold;
-  surface.density = 1.0f;
-  create_ground(world, surface, 1000.0f);
-  const std::vector<b2PolygonShape> pieces = box2d_pieces(shape);
-  std::vector<b2Body*> bodies;
-  for (const Body2State& s : init) {
-    b2BodyDef def;
-    def.type = b2_dynamicBody;
-    def.position.Set(static_cast<float>(s.x), static_cast<float>(s.y));
-    def.angle = static_cast<float>(s.angle);
-    def.linearVelocity.Set(static_cast<float>(s.vx), static_cast<float>(s.vy));
-    def.angularVelocity = static_cast<float>(s.w);
-    bodies.push_back(create_body(world, def, pieces, surface));
-  }
+  const std::vector<b2Body*> bodies = add_box2d_pile(world, shape, sig, init);
   const float h = static_cast<float>(o.dt);
   for (int step = 0; step < o.steps; ++step) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -250,6 +234,29 @@ MethodResult repeated(int repeat, Run run)
 }
 
 }  // namespace
+
+std::vector<b2Body*> add_box2d_pile(b2World& world, const Shape2& shape, const statsim::SignatureView<2>& sig,
+                                    const std::vector<Body2State>& init)
+{
+  Surface surface;
+  surface.friction = sig.material.friction;
+  surface.restitution = sig.material.restitution;
+  surface.restitution_threshold = sig.restitution_threshold;
+  surface.density = 1.0f;
+  create_ground(world, surface, 1000.0f);
+  const std::vector<b2PolygonShape> pieces = box2d_pieces(shape);
+  std::vector<b2Body*> bodies;
+  for (const Body2State& s : init) {
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position.Set(static_cast<float>(s.x), static_cast<float>(s.y));
+    def.angle = static_cast<float>(s.angle);
+    def.linearVelocity.Set(static_cast<float>(s.vx), static_cast<float>(s.vy));
+    def.angularVelocity = static_cast<float>(s.w);
+    bodies.push_back(create_body(world, def, pieces, surface));
+  }
+  return bodies;
+}
 
 bool compare2d_has_table(const std::string& shape)
 {

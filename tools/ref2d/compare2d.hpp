@@ -3,9 +3,14 @@
 // far the statistical result is from Box2D's.
 #pragma once
 
+#include "statsim/signature.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
+
+class b2World;
+class b2Body;
 
 namespace CLI {
 class App;
@@ -73,6 +78,14 @@ struct Compare2dResult {
 /// a square grid of the bodies, twice as tall), random orientations and small random velocities;
 /// deterministic in (seed, n, shape).
 std::vector<Body2State> compare2d_initial_states(const Compare2dOptions& options, double bounding_radius);
+
+struct Shape2;
+
+/// A pile's reference as `statsim compare2d` builds it: the ground and one body per initial state
+/// (in order) in `world`, with the table's material (Box2D density 1: only mass ratios matter).
+/// Returns the bodies.
+std::vector<b2Body*> add_box2d_pile(b2World& world, const Shape2& shape, const statsim::SignatureView<2>& sig,
+                                    const std::vector<Body2State>& init);
 
 /// True when a committed table for `shape` was compiled into the tools.
 bool compare2d_has_table(const std::string& shape);

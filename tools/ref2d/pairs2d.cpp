@@ -176,25 +176,9 @@ std::vector<Pairs2dPile> run_pile(const Pairs2dOptions& o, const Shape2& shape, 
   // As `statsim compare2d`'s Box2D run.
   b2World world(b2Vec2(0.0f, -9.81f));
   world.SetAllowSleeping(true);
-  Surface surface;
-  surface.friction = sig.material.friction;
-  surface.restitution = sig.material.restitution;
-  surface.restitution_threshold = sig.restitution_threshold;
-  surface.density = 1.0f;
-  create_ground(world, surface, 1000.0f);
-  const std::vector<b2PolygonShape> pieces = box2d_pieces(shape);
+  const std::vector<b2Body*> bodies = add_box2d_pile(world, shape, sig, init);
   std::map<const b2Body*, std::size_t> index;
-  std::vector<b2Body*> bodies;
-  for (const Body2State& s : init) {
-    b2BodyDef def;
-    def.type = b2_dynamicBody;
-    def.position.Set(static_cast<float>(s.x), static_cast<float>(s.y));
-    def.angle = static_cast<float>(s.angle);
-    def.linearVelocity.Set(static_cast<float>(s.vx), static_cast<float>(s.vy));
-    def.angularVelocity = static_cast<float>(s.w);
-    bodies.push_back(create_body(world, def, pieces, surface));
-    index[bodies.back()] = bodies.size() - 1;
-  }
+  for (std::size_t i = 0; i < bodies.size(); ++i) index[bodies[i]] = i;
   for (int step = 0; step < o.steps; ++step) world.Step(1.0f / 60.0f, 8, 3);
   asleep = true;
   for (b2Body* b : bodies) asleep = asleep && !b->IsAwake();

@@ -26,19 +26,6 @@ void check_common(const char* scene, int count, double radius, double spacing, d
   if (!(max_spin >= 0) || !std::isfinite(max_spin)) bad(scene, "max spin must be >= 0");
 }
 
-// The same draw as drop_scene3()'s: a uniform point of the unit 4-ball by rejection, normalised.
-Eigen::Quaterniond random_orientation(SceneRng& rng)
-{
-  for (;;) {
-    const double w = rng.uniform(-1, 1), x = rng.uniform(-1, 1), y = rng.uniform(-1, 1), z = rng.uniform(-1, 1);
-    const double n2 = w * w + x * x + y * y + z * z;
-    if (n2 > 1e-4 && n2 <= 1) {
-      const double n = std::sqrt(n2);
-      return Eigen::Quaterniond(w / n, x / n, y / n, z / n);
-    }
-  }
-}
-
 // A body in the cell centred on `centre`: jittered within the cell, random orientation, small
 // random velocities.
 BodyState3 random_body(SceneRng& rng, const Eigen::Vector3d& centre, double jitter, double max_speed, double max_spin)

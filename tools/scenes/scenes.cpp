@@ -45,11 +45,6 @@ void validate(const DropOptions& o)
   if (!(o.max_spin >= 0) || !std::isfinite(o.max_spin)) bad("max spin must be >= 0");
 }
 
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-// A uniformly random unit quaternion: a uniform point of the unit 4-ball (rejection), normalised.
 Eigen::Quaterniond random_orientation(SceneRng& rng)
 {
   for (;;) {
@@ -61,6 +56,10 @@ Eigen::Quaterniond random_orientation(SceneRng& rng)
     }
   }
 }
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
 
 // Fisher-Yates shuffle, then the first `count` indices.
 template <class Cell>

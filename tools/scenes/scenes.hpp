@@ -59,6 +59,10 @@ private:
   std::uint64_t state_;
 };
 
+/// A uniformly random unit quaternion, the draw of every 3D scene: a uniform point of the unit
+/// 4-ball by rejection, normalised (only + - * / and sqrt: the same bits on every platform).
+Eigen::Quaterniond random_orientation(SceneRng& rng);
+
 /// Initial state of a 3D body, SI units, world frame (z up).
 struct BodyState3 {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();                ///< centre of mass, m
