@@ -20,6 +20,9 @@ namespace statsim {
 struct Pair {
   std::uint32_t a;
   std::uint32_t b;
+  /// With hull contacts, the candidate normal the impact pass found for a touching pair
+  /// (`detail::find_hull_witness`), which the later passes of the step reuse.
+  std::uint32_t witness = 0;
 };
 
 /// One body's interval on the sweep axis.

@@ -23,6 +23,7 @@
 /// sideways and upward out of a packed pile each step, and the lift comes back as kinetic
 /// energy, so the pile never sleeps.
 
+#include "statsim/hull_contact.hpp"
 #include "statsim/world_data.hpp"
 
 #include <algorithm>
@@ -170,14 +171,15 @@ Scalar inverse_masses(const Body<D>& a, const Body<D>& b, const typename Space<D
   return ima + imb;
 }
 
-/// Pushes two bodies apart by the part of their overlap beyond `WorldDef::allowed_overlap`,
+/// Pushes two bodies apart by the part of their overlap beyond `WorldDef::allowed_overlap` (of
+/// `reach`, the separation at which they touch),
 /// times `overlap_correction`, split in proportion to inverse mass (in the bottom-up passes the
 /// lower body's is 0), so a sleeper does not move.
 template <int D>
 void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D>& b, const Contact<D>& c,
-                     Scalar slop, Scalar ima, Scalar imb, Scalar ims)
+                     Scalar slop, Scalar reach, Scalar ima, Scalar imb, Scalar ims)
 {
-  const Scalar depth = (c.depth - slop - w.def.allowed_overlap * (a.radius + b.radius)) * w.def.overlap_correction;
+  const Scalar depth = (c.depth - slop - w.def.allowed_overlap * reach) * w.def.overlap_correction;
   if (!(depth > 0)) return;
   a.position -= c.normal * (depth * ima / ims);
   b.position += c.normal * (depth * imb / ims);
@@ -223,7 +225,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       Contact<D> c;
       // Passes after the impact pass also see a body that the last pass left exactly touching.
       const Scalar slop = grown ? b.radius * contact_slop : Scalar(0);
-      if (!sphere_plane_contact<D>(b.position, b.radius + slop, w.planes[p], c)) continue;
+      if (!sphere_plane_contact<D>(b.position, plane_radius(w, b, w.planes[p]) + slop, w.planes[p], c)) continue;
       if (c.depth > slop) {
         b.position += c.normal * (c.depth - slop);
         ++ctx.moves;
@@ -258,11 +260,57 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
   return contacts;
 }
 
-/// The shared loop over body-body contacts among the first `count` candidate pairs (spheres
-/// grown by `contact_slop` of their radii's sum when `grown`). For each touching pair it calls
-/// `resolve(a, b, contact, slop)`, which returns false when neither body can move, and else
-/// marks both touching. With `compact`, touching pairs move to the front of the buffer, in their
-/// order. Returns the number of touching pairs.
+/// Whether the pair touches and how: at their collision spheres, or (`BodyContacts::hulls`,
+/// both shapes with a hull) along a hull candidate, searched afresh when `fresh` (the impact
+/// pass) and else the one the impact pass found. `slop_fraction`: spheres grown by this fraction
+/// of the reach. Fills the contact and the reach (separation along the normal at which they
+/// touch, m).
+template <int D>
+bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, bool fresh, Scalar slop_fraction,
+                  Contact<D>& c, Scalar& reach, Scalar& slop)
+{
+  using Vec = typename Space<D>::Vec;
+  const Shape<D>& sa = w.shapes[a.shape];
+  const Shape<D>& sb = w.shapes[b.shape];
+  if (w.def.body_contacts != BodyContacts::hulls || !has_hull(sa) || !has_hull(sb) ||
+      (!sa.statistical && !sb.statistical)) {
+    reach = a.radius + b.radius;
+    slop = reach * slop_fraction;
+    return sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c);
+  }
+  const Vec d = b.position - a.position;
+  const Scalar dist2 = d.squaredNorm();
+  const Scalar bound = a.bounding_radius + b.bounding_radius;
+  if (!(dist2 < bound * bound)) return false;
+  const Scalar dist = std::sqrt(dist2);
+  // Coincident centres: any direction is as good; up keeps it defined and deterministic.
+  const Vec e = dist > bound * Scalar(1e-6) ? Vec(d / dist) : Vec(Vec::Unit(Space<D>::up_axis));
+  const int up = Space<D>::up_axis;
+  const Scalar ratio = a.shape == b.shape
+                           ? packing_ratio(sa, e[up])
+                           : Scalar(0.5) * (packing_ratio(sa, e[up]) + packing_ratio(sb, e[up]));
+  if (fresh) {
+    pair.witness = find_hull_witness(sa, a, sb, b, e, dist, ratio);
+    if (pair.witness == no_witness) return false;
+  } else if (pair.witness == no_witness) {
+    return false;
+  }
+  const HullCandidate<D> h = hull_candidate(sa, a, sb, b, e, pair.witness);
+  reach = ratio * h.reach;
+  slop = reach * slop_fraction;
+  const Scalar depth = reach + slop - d.dot(h.normal);
+  if (!(depth > 0)) return false;
+  c.normal = h.normal;
+  c.depth = depth;
+  return true;
+}
+
+/// The shared loop over body-body contacts among the first `count` candidate pairs (grown by
+/// `contact_slop` of their reach when `grown`; the impact pass, not grown, finds each pair's
+/// hull contact afresh). For each touching pair it calls `resolve(a, b, contact, slop, reach)`,
+/// which returns false when neither body can move, and else marks both touching. With
+/// `compact`, touching pairs move to the front of the buffer, in their order. Returns the
+/// number of touching pairs.
 template <int D, class Resolve>
 std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bool compact, Resolve&& resolve)
 {
@@ -271,11 +319,11 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
     Body<D>& a = w.bodies[w.pairs[k].a];
     Body<D>& b = w.bodies[w.pairs[k].b];
     Contact<D> c;
-    const Scalar slop = grown ? (a.radius + b.radius) * contact_slop : Scalar(0);
-    if (!sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c)) continue;
+    Scalar reach, slop;
+    if (!body_contact(w, a, b, w.pairs[k], !grown, grown ? contact_slop : Scalar(0), c, reach, slop)) continue;
     if (compact) std::swap(w.pairs[touching], w.pairs[k]);
     ++touching;
-    if (!resolve(a, b, c, slop)) continue;
+    if (!resolve(a, b, c, slop, reach)) continue;
     a.touching = true;
     b.touching = true;
   }
@@ -319,7 +367,7 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
       ++ctx.changes;
   });
   ctx.touching = pair_contacts(w, w.pair_count, false, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c,
-                                                                 Scalar slop) {
+                                                                 Scalar slop, Scalar reach) {
     const Vec& n = c.normal;
     const bool a_asleep = a.state == MotionState::asleep;
     const bool b_asleep = b.state == MotionState::asleep;
@@ -336,7 +384,7 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
     if (ims <= 0) return false;
     if (w.shapes[a.shape].statistical || w.shapes[b.shape].statistical) respond_pair(w, ctx, a, b, n, ima, imb);
     else if (particle_pair(w, a, b, n, ima, imb, def.restitution_threshold)) ++ctx.changes;
-    if (!def.shock_propagation) correct_overlap(w, ctx, a, b, c, slop, ima, imb, ims);
+    if (!def.shock_propagation) correct_overlap(w, ctx, a, b, c, slop, reach, ima, imb, ims);
     return true;
   });
   return plane_count + ctx.touching;
@@ -349,7 +397,7 @@ template <int D>
 std::uint32_t support_pass(WorldData<D>& w, StepContext& ctx)
 {
   ctx.changes = 0;
-  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar) {
+  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar, Scalar) {
     Scalar ima, imb;
     if (inverse_masses(a, b, c.normal, false, ima, imb) <= 0) return false;
     if (particle_pair(w, a, b, c.normal, ima, imb, no_bounce)) ++ctx.changes;
@@ -384,12 +432,12 @@ std::uint32_t shock_pass(WorldData<D>& w, StepContext& ctx)
 {
   sort_bottom_up(w, ctx.touching);
   ctx.moves = 0;
-  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop) {
+  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop, Scalar reach) {
     Scalar ima, imb;
     const Scalar ims = inverse_masses(a, b, c.normal, true, ima, imb);
     if (ims <= 0) return false;
     if (particle_pair(w, a, b, c.normal, ima, imb, no_bounce)) ++ctx.changes;
-    correct_overlap(w, ctx, a, b, c, slop, ima, imb, ims);
+    correct_overlap(w, ctx, a, b, c, slop, reach, ima, imb, ims);
     return true;
   });
   support_planes(w, ctx);
@@ -403,11 +451,11 @@ template <int D>
 std::uint32_t position_pass(WorldData<D>& w, StepContext& ctx)
 {
   ctx.moves = 0;
-  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop) {
+  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop, Scalar reach) {
     Scalar ima, imb;
     const Scalar ims = inverse_masses(a, b, c.normal, true, ima, imb);
     if (ims <= 0) return false;
-    correct_overlap(w, ctx, a, b, c, slop, ima, imb, ims);
+    correct_overlap(w, ctx, a, b, c, slop, reach, ima, imb, ims);
     return true;
   });
   plane_contacts(w, ctx, true, [](Body<D>&, const Contact<D>&, bool, bool) {});

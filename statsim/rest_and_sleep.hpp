@@ -4,6 +4,7 @@
 /// (paper 3.3.1), and at its end the resting conditions (paper 3.4) and the motion states
 /// (moving, settling, asleep).
 
+#include "statsim/hull_contact.hpp"
 #include "statsim/world_data.hpp"
 
 #include <cstdint>
@@ -153,10 +154,13 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
       if (b.rest_pose != no_rest_pose && b.on_ground) {
         // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
         // the radius blend are below what a slow body would show.
+        // The centre stood `hull_radius` above the ground (the collision radius, or the hull's
+        // support where that is more): it ends at the pose's height above it.
         const SignatureView<D>& sig = w.shapes[b.shape].signature;
+        const Scalar above = hull_radius(w, b, ground);
         b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
         const Scalar h = sig.rest.heights[b.rest_pose];
-        b.position += ground * (h - b.radius);
+        b.position += ground * (h - above);
         b.radius = h;
         b.rest_blend = 1;
       }

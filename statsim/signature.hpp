@@ -222,6 +222,44 @@ struct RestPosesView {
   }
 };
 
+/// Body-body data of a shape (optional: `support_size` 0 when the table has none), from
+/// `statsim gather`'s pair runs (tools/ref3d/README.md, "Body-body statistics"):
+///  - the pair distance: centre distance of two bodies of the shape at their first contact,
+///    thrown head-on at uniform random orientations, mean and spread on the h_coll axis: the
+///    pair counterpart of h_coll;
+///  - the support map of the convex hull, s(u) = max over hull points p of u.p in body
+///    direction u: on each face of the cube |x|_inf = 1 (3D; the square's sides in 2D),
+///    S x S (2D: S) samples of s at p = (+-1, a, b), axes cyclic, a, b = -1 + 2 i / (S - 1);
+///    face f = 2 m + (u_m < 0) for u's largest component m (the first of equals), value
+///    (f S + i) S + j (2D: f S + i). It is never below the hull's support, so two bodies placed
+///    by it never overlap their hulls;
+///  - the hull's largest faces (2D: edges), largest first: outward unit normal in the body frame
+///    and its distance from the centre of mass, m;
+///  - packing: centre distance of touching neighbours in reference piles over the distance
+///    their hulls allow along the line of centres, mean and standard deviation, for lines of
+///    centres 0-30, 30-60 and 60-90 degrees from the vertical (1 for convex shapes; below 1 where
+///    concave shapes nest).
+/// Most support map nodes a side that the runtime takes (65: a 3D map of 25,350 values).
+constexpr std::uint32_t max_support_size = 65;
+/// Most hull faces a table may give for body-body contacts; each is a candidate normal, so
+/// they bound the cost of a contact.
+constexpr std::uint32_t max_contact_faces = 32;
+
+template <int D>
+struct ContactView {
+  std::uint32_t support_size = 0;  ///< S, >= 2; 0: no body-body data
+  ValuesView support;              ///< m, 6 S^2 values (2D: 4 S)
+  const Scalar* pair_mean = nullptr;    ///< m, one per h_coll axis sample
+  const Scalar* pair_stddev = nullptr;  ///< m
+  const Scalar* faces = nullptr;        ///< D + 1 numbers per face: unit normal, offset (m)
+  std::uint32_t face_count = 0;
+  std::array<Scalar, 3> packing_mean{};    ///< ratio, by angle of the line of centres
+  std::array<Scalar, 3> packing_stddev{};  ///< ratio
+  bool present() const { return support_size >= 2; }
+  /// Number of support values: 6 S^2 in 3D, 4 S in 2D.
+  std::uint32_t support_count() const { return D == 3 ? 6 * support_size * support_size : 4 * support_size; }
+};
+
 /// Which axes a response table has, in order (the generator writes one of these).
 enum class ResponseLayout : std::uint8_t {
   /// 3D: cos(theta), cos(phi), spin ratio. 2D: cos(theta), signed spin ratio.
@@ -246,6 +284,11 @@ struct SignatureView {
   HeightTableView height;
   ResponseTableView response;  ///< components: 2D w, dv_x, dv_y; 3D w_xyz, dv_xyz
   RestPosesView<D> rest;
+  /// Where the mesh the table was gathered from sits in the body frame: a mesh point m is the
+  /// body point R (m - c), R (D x D, row by row) then c (m, mesh frame); null when the table
+  /// does not record it (body frame = mesh frame).
+  const Scalar* mesh_frame = nullptr;
+  ContactView<D> contact;  ///< body-body data; absent (`present()` false) in older tables
 };
 
 /// 16-bit storage of N table values: value = offset + scale * Scalar(q[i]).
@@ -284,6 +327,16 @@ constexpr ValuesView values_view(const Values& v)
     return ValuesView{v.data(), nullptr, 1, 0};
   }
 }
+
+template <class T, class = void>
+struct has_contact_data : std::false_type {};
+template <class T>
+struct has_contact_data<T, std::void_t<decltype(std::declval<const T&>().contact.support)>> : std::true_type {};
+
+template <class T, class = void>
+struct has_mesh_frame : std::false_type {};
+template <class T>
+struct has_mesh_frame<T, std::void_t<decltype(std::declval<const T&>().mesh_frame)>> : std::true_type {};
 
 template <class Values>
 constexpr std::uint32_t values_count(const Values& v)
@@ -370,15 +423,74 @@ constexpr SignatureView<D> signature_view(const S& s)
   v.rest.heights = s.rest_heights.data();
   v.rest.frequencies = s.rest_frequencies.data();
   v.rest.count = static_cast<std::uint32_t>(s.rest_heights.size());
+  if constexpr (detail::has_mesh_frame<S>::value) {
+    v.mesh_frame = s.mesh_frame.size() == std::size_t(D * (D + 1)) ? s.mesh_frame.data() : nullptr;
+  }
+  if constexpr (detail::has_contact_data<S>::value) {
+    const auto& c = s.contact;
+    v.contact.support_size = c.support_size;
+    v.contact.support = detail::values_view(c.support);
+    v.contact.pair_mean = c.pair_mean.size() > 0 ? c.pair_mean.data() : nullptr;
+    v.contact.pair_stddev = c.pair_stddev.size() > 0 ? c.pair_stddev.data() : nullptr;
+    v.contact.faces = c.faces.size() > 0 ? c.faces.data() : nullptr;
+    v.contact.face_count = static_cast<std::uint32_t>(c.faces.size() / (D + 1));
+    for (std::size_t k = 0; k < 3; ++k) {
+      v.contact.packing_mean[k] = c.packing_mean[k];
+      v.contact.packing_stddev[k] = c.packing_stddev[k];
+    }
+    // A support table whose size is not its S's reads as absent, which `add_shape` rejects.
+    if (detail::values_count(c.support) != v.contact.support_count()) v.contact.support = ValuesView{};
+  }
   return v;
 }
+
+/// Body-body data of a generated signature (see `ContactView`); sizes are template arguments.
+///   NH: samples of the h_coll axis (the pair distance's axis); S: support map nodes per side;
+///   K: hull faces; `Support`: `std::array<Scalar, N>` or `Quantized16<N>`,
+///   N = `support_values(D, S)`.
+template <int D, std::uint32_t NH, std::uint32_t S, std::uint32_t K, class Support>
+struct BasicContactData {
+  static_assert(S >= 2, "a support map needs at least 2 nodes a side");
+  std::uint32_t support_size;
+  std::array<Scalar, NH> pair_mean;    ///< m
+  std::array<Scalar, NH> pair_stddev;  ///< m
+  Support support;                     ///< m
+  std::array<Scalar, K * (D + 1)> faces;
+  std::array<Scalar, 3> packing_mean;
+  std::array<Scalar, 3> packing_stddev;
+};
+
+/// Values of a support map with S nodes a side: 6 S^2 in 3D, 4 S in 2D.
+constexpr std::uint32_t support_values(int d, std::uint32_t s) { return d == 3 ? 6 * s * s : 4 * s; }
+
+template <int D, std::uint32_t NH, std::uint32_t S, std::uint32_t K>
+using ContactData = BasicContactData<D, NH, S, K, std::array<Scalar, support_values(D, S)>>;
+template <int D, std::uint32_t NH, std::uint32_t S, std::uint32_t K>
+using ContactDataQ16 = BasicContactData<D, NH, S, K, Quantized16<support_values(D, S)>>;
+
+/// The `contact` of a table without body-body data (tables of format 2.0).
+struct NoContactData {};
+
+namespace detail {
+/// The identity mesh frame: R = I, c = 0.
+template <int D>
+constexpr std::array<Scalar, D*(D + 1)> identity_mesh_frame()
+{
+  std::array<Scalar, D*(D + 1)> f{};
+  for (int k = 0; k < D; ++k) f[std::size_t(k * D + k)] = 1;
+  return f;
+}
+}  // namespace detail
 
 /// Storage of a generated signature; sizes are template arguments. Aggregate-initialised by the
 /// generated header, read by the runtime through `view()`. `Means` and `Spreads` hold the
 /// response tables: `std::array<Scalar, N>` (`Signature`) or `Quantized16<N>` (`SignatureQ16`).
-///   NH: height samples; A0..A3: response axis sizes (unused axes 1); NR: rest poses.
+///   NH: height samples; A0..A3: response axis sizes (unused axes 1); NR: rest poses;
+///   `Contact`: `ContactData`/`ContactDataQ16`, or `NoContactData`.
+/// The last two members are new in format 2.1 and have defaults, so a table of format 2.0 (which
+/// initialises everything before them) still compiles and loads, without body-body data.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, class Means, class Spreads>
+          std::uint32_t NR, class Means, class Spreads, class Contact = NoContactData>
 struct BasicSignature {
   static constexpr std::uint32_t components = D == 3 ? 6 : 3;
   static constexpr std::uint32_t cells = A0 * A1 * A2 * A3;
@@ -406,6 +518,8 @@ struct BasicSignature {
   std::array<Scalar, NR * D> rest_normals;
   std::array<Scalar, NR> rest_heights;
   std::array<Scalar, NR> rest_frequencies;
+  std::array<Scalar, D*(D + 1)> mesh_frame = detail::identity_mesh_frame<D>();  ///< see `SignatureView`
+  Contact contact = {};
 
   constexpr SignatureView<D> view() const { return signature_view<D>(*this); }
 };
@@ -414,16 +528,16 @@ struct BasicSignature {
 /// S: spread values per cell (`response_spread_size` of the table's model; the default is the
 /// paper's model, one standard deviation per component).
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u)>
+          std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u), class Contact = NoContactData>
 using Signature = BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>,
-                                 std::array<Scalar, A0 * A1 * A2 * A3 * S>>;
+                                 std::array<Scalar, A0 * A1 * A2 * A3 * S>, Contact>;
 
 /// A signature whose response tables are 16-bit integers (one scale and offset per table), for
 /// firmware where flash is tight; made from a `Signature` by `quantize16`.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u)>
+          std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u), class Contact = NoContactData>
 using SignatureQ16 = BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>,
-                                    Quantized16<A0 * A1 * A2 * A3 * S>>;
+                                    Quantized16<A0 * A1 * A2 * A3 * S>, Contact>;
 
 }  // namespace statsim
 

@@ -9,18 +9,19 @@
 namespace statsim {
 
 /// The 16-bit form of a float signature, by the rule of `quantize16`: everything but the response
-/// tables is copied. `inline constexpr auto t16 = statsim::quantize16(tables::box);` keeps only
+/// tables is copied (body-body data too, in the precision it has). `inline constexpr auto t16 = statsim::quantize16(tables::box);` keeps only
 /// the 16-bit table in the program.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS>
-constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>> quantize16(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C>
+constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C> quantize16(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C>& s)
 {
-  BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>> q{
+  BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C> q{
       s.name,        s.length,      s.bounding_radius, s.mass,         s.unit_inertia, s.material,
       s.restitution_threshold,      s.layout,          s.model,        s.axis_count,   s.height_axis,
       s.height_mean, s.height_stddev, s.axis0,         s.axis1,        s.axis2,        s.axis3,
-      {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies};
+      {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies,
+      s.mesh_frame,  s.contact};
   quantize16(s.response_mean.data(), s.response_mean.size(), q.response_mean.scale, q.response_mean.offset,
              q.response_mean.q.data());
   quantize16(s.response_spread.data(), s.response_spread.size(), q.response_spread.scale,
@@ -32,9 +33,9 @@ constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16
 /// A table already in 16-bit form stays as it is: `quantize16(tables::box)` holds whichever
 /// precision the committed table was generated with.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS>
-constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>>& quantize16(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C>
+constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C>& quantize16(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C>& s)
 {
   return s;
 }
@@ -43,15 +44,16 @@ constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quant
 /// the runtime reads a 16-bit table, so both forms give a world the same values. For builds that
 /// need float tables (a test of the float path) from a table committed in 16 bits.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS>
-constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>> dequantize(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C>
+constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C> dequantize(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C>& s)
 {
-  BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>> f{
+  BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C> f{
       s.name,        s.length,      s.bounding_radius, s.mass,         s.unit_inertia, s.material,
       s.restitution_threshold,      s.layout,          s.model,        s.axis_count,   s.height_axis,
       s.height_mean, s.height_stddev, s.axis0,         s.axis1,        s.axis2,        s.axis3,
-      {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies};
+      {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies,
+      s.mesh_frame,  s.contact};
   for (std::size_t i = 0; i < NM; ++i)
     f.response_mean[i] = s.response_mean.offset + s.response_mean.scale * Scalar(s.response_mean.q[i]);
   for (std::size_t i = 0; i < NS; ++i)
@@ -61,9 +63,9 @@ constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std:
 
 /// A float table stays as it is (see the 16-bit overload).
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS>
-constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>>& dequantize(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C>
+constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C>& dequantize(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C>& s)
 {
   return s;
 }

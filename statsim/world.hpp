@@ -65,7 +65,8 @@ class WorldCore {
     const Status s = detail::check_shape_def(def, bound);
     if (s != Status::ok) return {s, 0};
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, 0};
-    w_.shapes[w_.shape_count] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius, 0};
+    w_.shapes[w_.shape_count] =
+        Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius, 0, def.radius};
     return {Status::ok, ShapeId(w_.shape_count++)};
   }
 
@@ -97,8 +98,18 @@ class WorldCore {
       weight += sig.rest.frequencies[i];
     }
     const Scalar mean_rest = weight > 0 ? weighted / weight : (rest_max > 0 ? rest_max : sig.height.mean[0]);
+    // With body-body data a body also touches others as far out as its support map reaches,
+    // times the largest packing ratio.
+    Scalar floor = 0;
+    if (sig.contact.present()) {
+      const detail::SupportBounds sb = detail::support_bounds(sig.contact);
+      Scalar packing = 1;
+      for (Scalar p : sig.contact.packing_mean) packing = p > packing ? p : packing;
+      largest = sb.ceiling * packing > largest ? sb.ceiling * packing : largest;
+      floor = sb.floor;
+    }
     Shape<D>& shape = w_.shapes[w_.shape_count];
-    shape = Shape<D>{0, largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig)};
+    shape = Shape<D>{0, largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig), floor};
     rest_basin_biases<D>(sig, shape.rest_bias.data());
     return {Status::ok, ShapeId(w_.shape_count++)};
   }

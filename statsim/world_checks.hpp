@@ -105,6 +105,11 @@ Status check_signature_layout(const SignatureView<D>& sig)
   if (rest.count > max_rest_poses) return Status::invalid_shape;
   if (rest.count > 0 && (rest.normals == nullptr || rest.heights == nullptr || rest.frequencies == nullptr))
     return Status::invalid_shape;
+  const ContactView<D>& c = sig.contact;
+  if (c.support_size == 0) return Status::ok;
+  if (c.support_size < 2 || c.support_size > max_support_size || !readable(c.support)) return Status::invalid_shape;
+  if ((c.pair_mean == nullptr) != (c.pair_stddev == nullptr)) return Status::invalid_shape;
+  if (c.face_count > max_contact_faces || (c.face_count > 0 && c.faces == nullptr)) return Status::invalid_shape;
   return Status::ok;
 }
 
@@ -151,6 +156,28 @@ Status check_signature_values(const SignatureView<D>& sig)
     const Scalar f = sig.rest.frequencies[i];
     if (!(f >= 0 && f <= 1)) return Status::invalid_shape;  // NaN fails too
   }
+  // Body-body data: support values are distances of the hull's farthest point along a direction
+  // with a cube-face coordinate up to sqrt(3) (2D: sqrt(2)) long, so within that many bounding
+  // radii of the centre; face normals unit; packing ratios in (0, 2].
+  const ContactView<D>& c = sig.contact;
+  if (!c.present()) return Status::ok;
+  if (bad(c.support.scale) || bad(c.support.offset)) return Status::invalid_shape;
+  const Scalar reach = 2 * sig.bounding_radius;
+  for (std::uint32_t i = 0; i < c.support_count(); ++i)
+    if (bad(c.support[i]) || !(std::fabs(c.support[i]) <= reach)) return Status::invalid_shape;
+  if (c.pair_mean != nullptr)
+    for (std::uint32_t i = 0; i < h.spin_ratio.size; ++i)
+      if (!(c.pair_mean[i] > 0 && c.pair_mean[i] <= reach) || bad(c.pair_stddev[i]) || c.pair_stddev[i] < 0)
+        return Status::invalid_shape;
+  for (std::uint32_t k = 0; k < c.face_count; ++k) {
+    const Scalar* f = c.faces + k * (D + 1);
+    Scalar n2 = 0;
+    for (int d = 0; d < D; ++d) n2 += f[d] * f[d];
+    if (!(std::fabs(n2 - 1) < Scalar(2e-3)) || !(std::fabs(f[D]) <= sig.bounding_radius)) return Status::invalid_shape;
+  }
+  for (std::size_t k = 0; k < 3; ++k)
+    if (!(c.packing_mean[k] > 0 && c.packing_mean[k] <= 2) || !(c.packing_stddev[k] >= 0 && c.packing_stddev[k] <= 2))
+      return Status::invalid_shape;
   return Status::ok;
 }
 

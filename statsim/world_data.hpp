@@ -101,6 +101,9 @@ void hash_def(Fnv1a& h, const WorldDef<D>& d)
             std::uint8_t(d.pair_response), std::uint8_t(d.rest_conditions), std::uint8_t(d.pile_rest),
             d.rest_blend_time, d.rest_turn_time, d.rest_snap_cosine, d.ground_cosine, std::uint8_t(d.broad_phase),
             d.grid_above_bodies, std::int32_t(d.sweep_axis), std::uint8_t(d.table_restitution_threshold));
+  // Added only when not the default, so that worlds whose tables have no body-body data (which
+  // step as before the option) keep their hashes.
+  if (d.body_contacts != BodyContacts::hulls) h.add(std::uint8_t(d.body_contacts));
 }
 
 /// Adds a table's numbers as the runtime reads them (16-bit ones as their values).
@@ -141,6 +144,15 @@ std::uint64_t signature_hash(const SignatureView<D>& sig)
     h.add(sig.rest.heights[i]);
     h.add(sig.rest.frequencies[i]);
   }
+  // Body-body data, when the table has it (a table without it hashes as before).
+  const ContactView<D>& c = sig.contact;
+  if (!c.present()) return h.value;
+  h.add_all(c.support_size, c.face_count);
+  hash_values(h, c.support, c.support_count());
+  for (std::uint32_t i = 0; i < c.face_count * (D + 1); ++i) h.add(c.faces[i]);
+  for (std::size_t k = 0; k < 3; ++k) h.add_all(c.packing_mean[k], c.packing_stddev[k]);
+  if (c.pair_mean != nullptr)
+    for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i) h.add_all(c.pair_mean[i], c.pair_stddev[i]);
   return h.value;
 }
 

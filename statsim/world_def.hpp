@@ -83,6 +83,18 @@ enum class PairResponse : std::uint8_t {
   momentum,     ///< the same samples, combined into one momentum-conserving impulse
 };
 
+/// Where two bodies touch (see statsim/hull_contact.hpp).
+enum class BodyContacts : std::uint8_t {
+  /// Paper 3.3.1: at the sum of their collision radii, whatever their orientations.
+  collision_spheres,
+  /// At the distance their hulls allow at their current orientations (the signature's support
+  /// map and largest faces) times the shape's packing ratio from reference piles, along the
+  /// candidate contact normal that allows the least; for pairs whose tables both have
+  /// body-body data (a plain sphere counts as having it), else as `collision_spheres`.
+  /// Settling bodies also keep their hull out of planes.
+  hulls,
+};
+
 /// Parameters of a world. Defaults suit bodies of 5 cm to 1 m at 30 to 240 Hz.
 template <int D>
 struct WorldDef {
@@ -150,6 +162,9 @@ struct WorldDef {
   /// samples made to conserve momentum (the default: in piles the independent responses add
   /// energy, see statsim/README.md, "Statistical bodies").
   PairResponse pair_response = PairResponse::momentum;
+  /// Where bodies touch each other: at their hulls (default; the paper's spheres for tables
+  /// without body-body data), or always at their collision spheres.
+  BodyContacts body_contacts = BodyContacts::hulls;
   /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
   bool rest_conditions = true;
   /// Bodies settling on other bodies (not on the ground) blend their radius to the shape's
@@ -236,6 +251,9 @@ struct Shape {
   /// FNV-1a hash of the signature's numbers (`detail::signature_hash`), for `state_hash`; 0 for
   /// a plain sphere.
   std::uint64_t signature_hash;
+  /// The least support the table's support map can give (`detail::support_floor`), m; 0
+  /// without body-body data.
+  Scalar support_floor;
 };
 
 }  // namespace statsim

@@ -1,0 +1,282 @@
+#pragma once
+/// @file
+/// Body-body contact from the shapes' hulls (`BodyContacts::hulls`): where two bodies at their
+/// current orientations touch, from the support maps and largest faces of their signatures
+/// (`ContactView`), instead of at the sum of their collision radii.
+///
+/// For any unit n with n.e > 0 (e: the unit line of centres, from a to b), two convex hulls are
+/// apart while the separation of their centres along n exceeds the sum of their supports,
+/// (c_b - c_a).n > s_a(n) + s_b(-n). Along e they therefore touch no farther apart than
+///     d(e) = min over n of [s_a(n) + s_b(-n)] / (n.e),
+/// exactly at the contact normal when it is among the candidates. Candidates: e itself and
+/// the stored faces of either body (n = R_a f, or n = -R_b g), whose own support is their offset
+/// exactly; the other body's support comes from its support map, which never reads below the
+/// hull's. A pair touches when |c_b - c_a| < p d(e), p the packing ratio of the shapes (how much
+/// nearer than their hulls allow neighbours rest in reference piles; 1 for convex shapes), and
+/// the contact is taken along the minimising candidate n*, with the separation it needs
+/// target = p [s_a(n*) + s_b(-n*)]: so a box resting on two offset boxes is held along their
+/// faces' normal, not pushed sideways along the line of centres.
+///
+/// Cost per pair: two rotations and two map reads for e, then per face with n.e > 0 that can
+/// still beat the best candidate one rotation, one map read and one division; a fixed bound, no
+/// square root beyond |c_b - c_a|. A plain sphere of radius r takes part with s(u) = r and no
+/// faces, which is exact for a sphere against a hull.
+
+#include "statsim/world_data.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace statsim {
+namespace detail {
+
+/// A direction from the world frame into the body frame of orientation q (body to world).
+inline Vector3 to_body(const Quaternion& q, const Vector3& v) { return q.conjugate() * v; }
+inline Vector2 to_body(const Rot2& r, const Vector2& v) { return {r.c * v.x() + r.s * v.y(), r.c * v.y() - r.s * v.x()}; }
+inline Vector3 to_world(const Quaternion& q, const Vector3& v) { return q * v; }
+inline Vector2 to_world(const Rot2& r, const Vector2& v) { return r * v; }
+
+/// Cell and fraction of a face coordinate a in [-1, 1] on S nodes -1 + 2 i / (S - 1), clamped.
+inline void support_cell(Scalar a, std::uint32_t size, std::uint32_t& i, Scalar& t)
+{
+  const Scalar x = (a + 1) * (Scalar(0.5) * Scalar(size - 1));
+  const Scalar top = Scalar(size - 2);
+  const Scalar cell = x > 0 ? (x < top ? Scalar(static_cast<std::uint32_t>(x)) : top) : Scalar(0);
+  i = static_cast<std::uint32_t>(cell);
+  const Scalar f = x - cell;
+  t = f > 0 ? (f < 1 ? f : Scalar(1)) : Scalar(0);
+}
+
+/// The support map's value in body direction u (any length; s is homogeneous of degree 1):
+/// the face of u's largest component u_m (the first of equals), interpolated at the face
+/// coordinates of u / |u_m|, times |u_m|.
+inline Scalar support_along(const ContactView<3>& c, const Vector3& u)
+{
+  int m = 0;
+  Scalar um = std::fabs(u[0]);
+  if (std::fabs(u[1]) > um) {
+    m = 1;
+    um = std::fabs(u[1]);
+  }
+  if (std::fabs(u[2]) > um) {
+    m = 2;
+    um = std::fabs(u[2]);
+  }
+  if (!(um > 0)) return 0;
+  const std::uint32_t s = c.support_size;
+  const std::uint32_t face = std::uint32_t(2 * m) + (u[m] < 0 ? 1u : 0u);
+  std::uint32_t i, j;
+  Scalar t, w;
+  support_cell(u[(m + 1) % 3] / um, s, i, t);
+  support_cell(u[(m + 2) % 3] / um, s, j, w);
+  const std::uint32_t k = (face * s + i) * s + j;
+  const ValuesView& v = c.support;
+  const Scalar h = (1 - t) * ((1 - w) * v[k] + w * v[k + 1]) + t * ((1 - w) * v[k + s] + w * v[k + s + 1]);
+  return um * h;
+}
+
+inline Scalar support_along(const ContactView<2>& c, const Vector2& u)
+{
+  const int m = std::fabs(u[1]) > std::fabs(u[0]) ? 1 : 0;
+  const Scalar um = std::fabs(u[m]);
+  if (!(um > 0)) return 0;
+  const std::uint32_t s = c.support_size;
+  const std::uint32_t side = std::uint32_t(2 * m) + (u[m] < 0 ? 1u : 0u);
+  std::uint32_t i;
+  Scalar t;
+  support_cell(u[1 - m] / um, s, i, t);
+  const std::uint32_t k = side * s + i;
+  return um * ((1 - t) * c.support[k] + t * c.support[k + 1]);
+}
+
+/// True when body-body contacts of this shape can use its hull: a statistical shape whose table
+/// has body-body data, or a plain sphere.
+template <int D>
+bool has_hull(const Shape<D>& s)
+{
+  return !s.statistical || s.signature.contact.present();
+}
+
+/// The support of a shape in body direction u: its map, or a plain sphere's radius.
+template <int D>
+Scalar shape_support(const Shape<D>& s, const typename Space<D>::Vec& u)
+{
+  return s.statistical ? support_along(s.signature.contact, u) : s.radius;
+}
+
+/// Packing ratio of a shape for a line of centres whose up component is `up` (cos of its angle
+/// to the vertical, sign ignored): the table's three angle bins (0-30, 30-60, 60-90 degrees)
+/// taken at their centres (cos 15, 45, 75 degrees) and interpolated linearly between, constant
+/// beyond; 1 for a plain sphere.
+template <int D>
+Scalar packing_ratio(const Shape<D>& s, Scalar up)
+{
+  if (!s.statistical) return 1;
+  const std::array<Scalar, 3>& p = s.signature.contact.packing_mean;
+  constexpr Scalar c15 = Scalar(0.96592583), c45 = Scalar(0.70710678), c75 = Scalar(0.25881905);
+  const Scalar x = std::fabs(up);
+  if (x >= c15) return p[0];
+  if (x >= c45) return p[1] + (p[0] - p[1]) * ((x - c45) / (c15 - c45));
+  if (x >= c75) return p[2] + (p[1] - p[2]) * ((x - c75) / (c45 - c75));
+  return p[2];
+}
+
+/// A candidate contact of two hulls: its normal (from a to b, world frame) and the separation
+/// of the centres along it at which the hulls touch, s_a(n) + s_b(-n), m.
+template <int D>
+struct HullCandidate {
+  typename Space<D>::Vec normal;
+  Scalar reach;
+};
+
+/// Candidate `k` of a pair: 0 the line of centres `e`, 1 + i face i of a, 1 + K_a + i face i of
+/// b (K_a: a's face count).
+template <int D>
+HullCandidate<D> hull_candidate(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, const Body<D>& b,
+                                const typename Space<D>::Vec& e, std::uint32_t k)
+{
+  using Vec = typename Space<D>::Vec;
+  const std::uint32_t ka = sa.statistical ? sa.signature.contact.face_count : 0u;
+  if (k == 0) {
+    const Vec ea = to_body(a.orientation, e), eb = to_body(b.orientation, e);
+    return {e, shape_support(sa, ea) + shape_support(sb, Vec(-eb))};
+  }
+  if (k <= ka) {
+    const Scalar* f = sa.signature.contact.faces + (k - 1) * (D + 1);
+    const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
+    return {n, f[D] + shape_support(sb, to_body(b.orientation, Vec(-n)))};
+  }
+  const Scalar* g = sb.signature.contact.faces + (k - 1 - ka) * (D + 1);
+  const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
+  return {n, shape_support(sa, to_body(a.orientation, n)) + g[D]};
+}
+
+/// The hull contact of a pair whose centres are `d` apart (d = c_b - c_a, |d| = `dist` > 0):
+/// finds the candidate with the least distance along e and returns its index, or `no_witness`
+/// when the pair is apart at every candidate. `ratio`: the pair's packing ratio.
+constexpr std::uint32_t no_witness = 0xffffffffu;
+
+template <int D>
+std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, const Body<D>& b,
+                                const typename Space<D>::Vec& e, Scalar dist, Scalar ratio)
+{
+  using Vec = typename Space<D>::Vec;
+  // Along e itself first: the least distance is at most this one, so a pair apart along e is
+  // apart (the faces can only bring the distance down).
+  const Vec ea = to_body(a.orientation, e), eb = to_body(b.orientation, e);
+  Scalar best = shape_support(sa, ea) + shape_support(sb, Vec(-eb));
+  if (!(dist < ratio * best)) return no_witness;
+  std::uint32_t witness = 0;
+  // A face of a with offset o and n.e = c gives at least (o + floor_b) / c, floor_b the least
+  // support b's map can return: faces that cannot beat the best so far are skipped unread.
+  const Scalar floor_a = sa.statistical ? sa.support_floor : sa.radius;
+  const Scalar floor_b = sb.statistical ? sb.support_floor : sb.radius;
+  const std::uint32_t ka = sa.statistical ? sa.signature.contact.face_count : 0u;
+  const std::uint32_t kb = sb.statistical ? sb.signature.contact.face_count : 0u;
+  for (std::uint32_t i = 0; i < ka; ++i) {
+    const Scalar* f = sa.signature.contact.faces + i * (D + 1);
+    const Scalar c = Vec(Eigen::Map<const Vec>(f)).dot(ea);
+    if (!(c > 0) || !(f[D] + floor_b < best * c)) continue;
+    const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
+    const Scalar along = (f[D] + shape_support(sb, to_body(b.orientation, Vec(-n)))) / c;
+    if (along < best) {
+      best = along;
+      witness = 1 + i;
+    }
+  }
+  for (std::uint32_t i = 0; i < kb; ++i) {
+    const Scalar* g = sb.signature.contact.faces + i * (D + 1);
+    const Scalar c = -Vec(Eigen::Map<const Vec>(g)).dot(eb);
+    if (!(c > 0) || !(g[D] + floor_a < best * c)) continue;
+    const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
+    const Scalar along = (shape_support(sa, to_body(a.orientation, n)) + g[D]) / c;
+    if (along < best) {
+      best = along;
+      witness = 1 + ka + i;
+    }
+  }
+  return dist < ratio * best ? witness : no_witness;
+}
+
+/// The radius a body keeps from a plane of normal `n`: its collision radius, or, for a
+/// settling body with a hull (`BodyContacts::hulls`), at least its hull's support toward the
+/// plane, so that a body resting out of its rest poses (propped by others) does not sink its
+/// hull into the ground or a wall.
+template <int D>
+Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  const Shape<D>& s = w.shapes[b.shape];
+  if (w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling || !s.statistical ||
+      !s.signature.contact.present())
+    return b.radius;
+  const Scalar hull = support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
+  return hull > b.radius ? hull : b.radius;
+}
+
+/// `hull_radius` against a plane, where it matters: the support is read only when the plane is
+/// within the body's bounding radius.
+template <int D>
+Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& plane)
+{
+  if (!(plane.normal.dot(b.position) - plane.offset < b.bounding_radius)) return b.radius;
+  return hull_radius(w, b, plane.normal);
+}
+
+/// The least and the largest values the support map of `c` can return for a unit direction, m:
+/// per cell of each face, the least corner value over the largest |u| of the cell's points on
+/// the cube face (|u_m| = 1 / |p| for p = (1, a, b)), and the largest corner value over the
+/// least. Bilinear interpolation stays within its corners, so no lookup of a unit direction
+/// reads outside them. Computed once, by `add_shape`.
+struct SupportBounds {
+  Scalar floor;
+  Scalar ceiling;
+};
+
+template <int D>
+SupportBounds support_bounds(const ContactView<D>& c)
+{
+  const std::uint32_t s = c.support_size;
+  const std::uint32_t faces = D == 3 ? 6u : 4u, rows = D == 3 ? s - 1 : 1u;
+  const auto node = [s](std::uint32_t i) { return -1 + 2 * Scalar(i) / Scalar(s - 1); };
+  const auto far = [&node](std::uint32_t i) {
+    return std::fabs(node(i)) > std::fabs(node(i + 1)) ? std::fabs(node(i)) : std::fabs(node(i + 1));
+  };
+  // The node nearest the face's centre in [node(i), node(i+1)]: 0 when they straddle it.
+  const auto near = [&node](std::uint32_t i) {
+    const Scalar x = node(i), y = node(i + 1);
+    return x <= 0 && y >= 0 ? Scalar(0) : (std::fabs(x) < std::fabs(y) ? std::fabs(x) : std::fabs(y));
+  };
+  SupportBounds out{std::numeric_limits<Scalar>::infinity(), 0};
+  for (std::uint32_t f = 0; f < faces; ++f)
+    for (std::uint32_t i = 0; i + 1 < s; ++i)
+      for (std::uint32_t j = 0; j < rows; ++j) {
+        Scalar lo, hi, far2, near2;
+        if (D == 3) {
+          const std::uint32_t k = (f * s + i) * s + j;
+          const Scalar v[4] = {c.support[k], c.support[k + 1], c.support[k + s], c.support[k + s + 1]};
+          lo = hi = v[0];
+          for (Scalar x : v) {
+            lo = x < lo ? x : lo;
+            hi = x > hi ? x : hi;
+          }
+          far2 = far(i) * far(i) + far(j) * far(j);
+          near2 = near(i) * near(i) + near(j) * near(j);
+        } else {
+          const std::uint32_t k = f * s + i;
+          lo = c.support[k] < c.support[k + 1] ? c.support[k] : c.support[k + 1];
+          hi = c.support[k] > c.support[k + 1] ? c.support[k] : c.support[k + 1];
+          far2 = far(i) * far(i);
+          near2 = near(i) * near(i);
+        }
+        // |u_m| lies in [1 / sqrt(1 + far2), 1 / sqrt(1 + near2)] over the cell, and is at most 1.
+        const Scalar lo_u = lo > 0 ? lo / std::sqrt(1 + far2) : lo;
+        const Scalar hi_u = hi > 0 ? hi / std::sqrt(1 + near2) : hi / std::sqrt(1 + far2);
+        out.floor = lo_u < out.floor ? lo_u : out.floor;
+        out.ceiling = hi_u > out.ceiling ? hi_u : out.ceiling;
+      }
+  return out;
+}
+
+}  // namespace detail
+}  // namespace statsim
