@@ -39,6 +39,11 @@ constexpr Scalar no_bounce = std::numeric_limits<Scalar>::infinity();
 /// Passes after the impact pass count spheres within this fraction of their radius as touching:
 /// the impact pass leaves resting contacts exactly touching, not overlapping.
 constexpr Scalar contact_slop = Scalar(1e-3);
+/// A hull contact whose normal is within 60 degrees of up carries the upper body
+/// (`Body::supported`): it takes a rest pose there and turns into it. Steeper than the ground's
+/// `ground_cosine`, because a body lying tilted on another's edge or corner is what the turn
+/// must set down flat, as it would topple in the reference.
+constexpr Scalar carry_cosine = Scalar(0.5);
 
 /// The response of one body alone against a plane with normal `n` (towards the body), with
 /// its velocity taken relative to `other_velocity`: the statistical response for statistical
@@ -48,7 +53,8 @@ constexpr Scalar contact_slop = Scalar(1e-3);
 /// `tilted_plane`: the contact is with a plane that gravity pulls the body along.
 template <int D>
 void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const typename Space<D>::Vec& n,
-                   const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false)
+                   const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false,
+                   bool turn_up = false)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& shape = w.shapes[b.shape];
@@ -97,9 +103,13 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
     particle_plane_response<D>(v, b.angular_velocity, contact_radius(w, b), n, shape.material,
                                def.restitution_threshold);
   } else if (ground_contact && b.rest_pose != no_rest_pose) {
-    if (!(v.dot(n) < 0)) return;
-    v = point_particle_velocity<D>(v, n, shape.material, def.restitution_threshold);
-    b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, def.rest_turn_time);
+    // On another body the pair falls together, so a resting contact there need not approach:
+    // it turns all the same.
+    const bool approaching = v.dot(n) < 0;
+    if (!approaching && !turn_up) return;
+    if (approaching) v = point_particle_velocity<D>(v, n, shape.material, def.restitution_threshold);
+    const Vec toward = turn_up ? Vec(Vec::Unit(Space<D>::up_axis)) : n;
+    b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), toward, def.rest_turn_time);
     // A small turn (paper 3.4): its farthest point moves at most at the settle speed, so a
     // slow body is not spun up (sin(angle) / rest_turn_time alone reaches 10 rad/s).
     const Scalar cap = def.settle_speed / b.bounding_radius;
@@ -128,8 +138,12 @@ void respond_pair(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D>& 
 {
   using Vec = typename Space<D>::Vec;
   const Vec va = a.linear_velocity, vb = b.linear_velocity;
-  if (ima > 0) respond_alone(w, ctx, a, -n, vb, false);
-  if (imb > 0) respond_alone(w, ctx, b, n, va, false);
+  // With hull contacts a body resting on another near-level one turns into its rest pose there,
+  // as on the ground (paper 3.4).
+  const bool hulls = hull_pair(w, a, b);
+  const Scalar up = n[Space<D>::up_axis];
+  if (ima > 0) respond_alone(w, ctx, a, -n, vb, hulls && -up >= carry_cosine, false, true);
+  if (imb > 0) respond_alone(w, ctx, b, n, va, hulls && up >= carry_cosine, false, true);
   if (w.def.pair_response != PairResponse::momentum) return;
   // Change of (vb - va) as each body saw it; a static side saw none, so the other counts alone.
   const Vec from_b = (b.linear_velocity - va) - (vb - va);
@@ -152,8 +166,17 @@ bool particle_pair(const WorldData<D>& w, Body<D>& a, Body<D>& b, const typename
                                         : mix(w.shapes[a.shape].material, w.shapes[b.shape].material);
   const ContactSide<D> sa{a.linear_velocity, a.angular_velocity, ima, ra};
   const ContactSide<D> sb{b.linear_velocity, b.angular_velocity, imb, rb};
-  return ra == 0 && rb == 0 ? particle_point_response<D>(sa, sb, n, m, threshold)
-                            : particle_response<D>(sa, sb, n, m, threshold);
+  if (!hull_pair(w, a, b))
+    return ra == 0 && rb == 0 ? particle_point_response<D>(sa, sb, n, m, threshold)
+                              : particle_response<D>(sa, sb, n, m, threshold);
+  // A body turning into its rest pose on another spins because the resting conditions make it
+  // (`respond_alone`): rolling resistance, which stops a body's roll, would stop the turn.
+  const typename Space<D>::Spin wa = a.angular_velocity, wb = b.angular_velocity;
+  const bool applied = ra == 0 && rb == 0 ? particle_point_response<D>(sa, sb, n, m, threshold)
+                                          : particle_response<D>(sa, sb, n, m, threshold);
+  if (a.rest_pose != no_rest_pose && a.supported) a.angular_velocity = wa;
+  if (b.rest_pose != no_rest_pose && b.supported) b.angular_velocity = wb;
+  return applied;
 }
 
 /// Inverse masses of a touching pair: 0 for a sleeper. In the bottom-up passes (shock and
@@ -260,6 +283,17 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
   return contacts;
 }
 
+/// True when two bodies touch at their hulls (`BodyContacts::hulls`, both shapes with a hull, at
+/// least one statistical).
+template <int D>
+bool hull_pair(const WorldData<D>& w, const Body<D>& a, const Body<D>& b)
+{
+  const Shape<D>& sa = w.shapes[a.shape];
+  const Shape<D>& sb = w.shapes[b.shape];
+  return w.def.body_contacts == BodyContacts::hulls && has_hull(sa) && has_hull(sb) &&
+         (sa.statistical || sb.statistical);
+}
+
 /// Whether the pair touches and how: at their collision spheres, or (`BodyContacts::hulls`,
 /// both shapes with a hull) along a hull candidate, searched afresh when `fresh` (the impact
 /// pass) and else the one the impact pass found. `slop_fraction`: spheres grown by this fraction
@@ -272,8 +306,7 @@ bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, boo
   using Vec = typename Space<D>::Vec;
   const Shape<D>& sa = w.shapes[a.shape];
   const Shape<D>& sb = w.shapes[b.shape];
-  if (w.def.body_contacts != BodyContacts::hulls || !has_hull(sa) || !has_hull(sb) ||
-      (!sa.statistical && !sb.statistical)) {
+  if (!hull_pair(w, a, b)) {
     reach = a.radius + b.radius;
     slop = reach * slop_fraction;
     return sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c);
@@ -285,18 +318,16 @@ bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, boo
   const Scalar dist = std::sqrt(dist2);
   // Coincident centres: any direction is as good; up keeps it defined and deterministic.
   const Vec e = dist > bound * Scalar(1e-6) ? Vec(d / dist) : Vec(Vec::Unit(Space<D>::up_axis));
-  const int up = Space<D>::up_axis;
-  const Scalar ratio = a.shape == b.shape
-                           ? packing_ratio(sa, e[up])
-                           : Scalar(0.5) * (packing_ratio(sa, e[up]) + packing_ratio(sb, e[up]));
   if (fresh) {
-    pair.witness = find_hull_witness(sa, a, sb, b, e, dist, ratio);
+    const Scalar pa = sa.statistical ? sa.largest_packing : Scalar(1);
+    const Scalar pb = sb.statistical ? sb.largest_packing : Scalar(1);
+    pair.witness = find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb);
     if (pair.witness == no_witness) return false;
   } else if (pair.witness == no_witness) {
     return false;
   }
   const HullCandidate<D> h = hull_candidate(sa, a, sb, b, e, pair.witness);
-  reach = ratio * h.reach;
+  reach = (pair.witness == 0 ? pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
   slop = reach * slop_fraction;
   const Scalar depth = reach + slop - d.dot(h.normal);
   if (!(depth > 0)) return false;
@@ -326,6 +357,11 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
     if (!resolve(a, b, c, slop, reach)) continue;
     a.touching = true;
     b.touching = true;
+    if (!hull_pair(w, a, b)) continue;
+    // A hull contact near the vertical carries the upper body as the ground would.
+    const Scalar up = c.normal[Space<D>::up_axis];
+    if (up >= carry_cosine) b.supported = true;
+    else if (-up >= carry_cosine) a.supported = true;
   }
   return touching;
 }
@@ -337,6 +373,7 @@ void forget_contacts(WorldData<D>& w)
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     w.bodies[i].touching = false;
     w.bodies[i].on_ground = false;
+    w.bodies[i].supported = false;
   }
 }
 

@@ -15,7 +15,10 @@
 /// nearer than their hulls allow neighbours rest in reference piles; 1 for convex shapes), and
 /// the contact is taken along the minimising candidate n*, with the separation it needs
 /// target = p [s_a(n*) + s_b(-n*)]: so a box resting on two offset boxes is held along their
-/// faces' normal, not pushed sideways along the line of centres.
+/// faces' normal, not pushed sideways along the line of centres. p is measured per candidate:
+/// a face of the shape itself holds its neighbour at the hull (p = 1), a hull face that spans a
+/// hollow lets it nest (p < 1), and a contact along the line of centres takes the ratio for its
+/// angle to the vertical.
 ///
 /// Cost per pair: two rotations and two map reads for e, then per face with n.e > 0 that can
 /// still beat the best candidate one rotation, one map read and one division; a fixed bound, no
@@ -105,10 +108,10 @@ Scalar shape_support(const Shape<D>& s, const typename Space<D>::Vec& u)
   return s.statistical ? support_along(s.signature.contact, u) : s.radius;
 }
 
-/// Packing ratio of a shape for a line of centres whose up component is `up` (cos of its angle
-/// to the vertical, sign ignored): the table's three angle bins (0-30, 30-60, 60-90 degrees)
-/// taken at their centres (cos 15, 45, 75 degrees) and interpolated linearly between, constant
-/// beyond; 1 for a plain sphere.
+/// Packing ratio of a shape for a pair touching along its line of centres, whose up component
+/// is `up` (cos of its angle to the vertical, sign ignored): the table's three angle bins
+/// (0-30, 30-60, 60-90 degrees) taken at their centres (cos 15, 45, 75 degrees) and
+/// interpolated linearly between, constant beyond; 1 for a plain sphere.
 template <int D>
 Scalar packing_ratio(const Shape<D>& s, Scalar up)
 {
@@ -122,12 +125,15 @@ Scalar packing_ratio(const Shape<D>& s, Scalar up)
   return p[2];
 }
 
-/// A candidate contact of two hulls: its normal (from a to b, world frame) and the separation
-/// of the centres along it at which the hulls touch, s_a(n) + s_b(-n), m.
+/// A candidate contact of two hulls: its normal (from a to b, world frame), the separation of
+/// the centres along it at which the hulls touch, s_a(n) + s_b(-n) (m), and the packing ratio
+/// of contacts along it (a face's own; 0 for the line of centres, whose ratio depends on the
+/// pair, see `pair_packing`).
 template <int D>
 struct HullCandidate {
   typename Space<D>::Vec normal;
   Scalar reach;
+  Scalar packing;
 };
 
 /// Candidate `k` of a pair: 0 the line of centres `e`, 1 + i face i of a, 1 + K_a + i face i of
@@ -137,36 +143,64 @@ HullCandidate<D> hull_candidate(const Shape<D>& sa, const Body<D>& a, const Shap
                                 const typename Space<D>::Vec& e, std::uint32_t k)
 {
   using Vec = typename Space<D>::Vec;
+  constexpr std::uint32_t fv = face_values(D);
   const std::uint32_t ka = sa.statistical ? sa.signature.contact.face_count : 0u;
   if (k == 0) {
     const Vec ea = to_body(a.orientation, e), eb = to_body(b.orientation, e);
-    return {e, shape_support(sa, ea) + shape_support(sb, Vec(-eb))};
+    return {e, shape_support(sa, ea) + shape_support(sb, Vec(-eb)), 0};
   }
   if (k <= ka) {
-    const Scalar* f = sa.signature.contact.faces + (k - 1) * (D + 1);
+    const Scalar* f = sa.signature.contact.faces + (k - 1) * fv;
     const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
-    return {n, f[D] + shape_support(sb, to_body(b.orientation, Vec(-n)))};
+    return {n, f[D] + shape_support(sb, to_body(b.orientation, Vec(-n))), f[D + 1]};
   }
-  const Scalar* g = sb.signature.contact.faces + (k - 1 - ka) * (D + 1);
+  const Scalar* g = sb.signature.contact.faces + (k - 1 - ka) * fv;
   const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
-  return {n, shape_support(sa, to_body(a.orientation, n)) + g[D]};
+  return {n, shape_support(sa, to_body(a.orientation, n)) + g[D], g[D + 1]};
 }
 
-/// The hull contact of a pair whose centres are `d` apart (d = c_b - c_a, |d| = `dist` > 0):
-/// finds the candidate with the least distance along e and returns its index, or `no_witness`
-/// when the pair is apart at every candidate. `ratio`: the pair's packing ratio.
+/// Packing ratio of a pair touching along the line of centres `e`: each shape's by angle
+/// (`packing_ratio`), their mean for two shapes.
+template <int D>
+Scalar pair_packing(const Shape<D>& sa, const Shape<D>& sb, bool same_shape, const typename Space<D>::Vec& e)
+{
+  const Scalar up = e[Space<D>::up_axis];
+  return same_shape ? packing_ratio(sa, up) : Scalar(0.5) * (packing_ratio(sa, up) + packing_ratio(sb, up));
+}
+
+/// The largest packing ratio a contact of the shape can have (1 for a plain sphere): with it a
+/// pair apart along its line of centres is known to be apart.
+template <int D>
+Scalar largest_packing(const Shape<D>& s)
+{
+  if (!s.statistical) return 1;
+  const ContactView<D>& c = s.signature.contact;
+  Scalar p = 0;
+  for (Scalar x : c.packing_mean) p = x > p ? x : p;
+  for (std::uint32_t i = 0; i < c.face_count; ++i) {
+    const Scalar x = c.faces[i * face_values(D) + D + 1];
+    p = x > p ? x : p;
+  }
+  return p;
+}
+
+/// The hull contact of a pair whose centres are `d` apart (d = c_b - c_a, |d| = `dist` > 0,
+/// e = d / dist): the candidate with the least distance along e (the hulls' geometry alone),
+/// or `no_witness` when the pair is surely apart: farther than that distance times `packing`,
+/// the largest packing ratio either shape has.
 constexpr std::uint32_t no_witness = 0xffffffffu;
 
 template <int D>
 std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, const Body<D>& b,
-                                const typename Space<D>::Vec& e, Scalar dist, Scalar ratio)
+                                const typename Space<D>::Vec& e, Scalar dist, Scalar packing)
 {
   using Vec = typename Space<D>::Vec;
+  constexpr std::uint32_t fv = face_values(D);
   // Along e itself first: the least distance is at most this one, so a pair apart along e is
   // apart (the faces can only bring the distance down).
   const Vec ea = to_body(a.orientation, e), eb = to_body(b.orientation, e);
   Scalar best = shape_support(sa, ea) + shape_support(sb, Vec(-eb));
-  if (!(dist < ratio * best)) return no_witness;
+  if (!(dist < packing * best)) return no_witness;
   std::uint32_t witness = 0;
   // A face of a with offset o and n.e = c gives at least (o + floor_b) / c, floor_b the least
   // support b's map can return: faces that cannot beat the best so far are skipped unread.
@@ -175,28 +209,28 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
   const std::uint32_t ka = sa.statistical ? sa.signature.contact.face_count : 0u;
   const std::uint32_t kb = sb.statistical ? sb.signature.contact.face_count : 0u;
   for (std::uint32_t i = 0; i < ka; ++i) {
-    const Scalar* f = sa.signature.contact.faces + i * (D + 1);
+    const Scalar* f = sa.signature.contact.faces + i * fv;
     const Scalar c = Vec(Eigen::Map<const Vec>(f)).dot(ea);
     if (!(c > 0) || !(f[D] + floor_b < best * c)) continue;
     const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
     const Scalar along = (f[D] + shape_support(sb, to_body(b.orientation, Vec(-n)))) / c;
-    if (along < best) {
+    if (!(along > best)) {
       best = along;
       witness = 1 + i;
     }
   }
   for (std::uint32_t i = 0; i < kb; ++i) {
-    const Scalar* g = sb.signature.contact.faces + i * (D + 1);
+    const Scalar* g = sb.signature.contact.faces + i * fv;
     const Scalar c = -Vec(Eigen::Map<const Vec>(g)).dot(eb);
     if (!(c > 0) || !(g[D] + floor_a < best * c)) continue;
     const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
     const Scalar along = (shape_support(sa, to_body(a.orientation, n)) + g[D]) / c;
-    if (along < best) {
+    if (!(along > best)) {
       best = along;
       witness = 1 + ka + i;
     }
   }
-  return dist < ratio * best ? witness : no_witness;
+  return dist < packing * best ? witness : no_witness;
 }
 
 /// The radius a body keeps from a plane of normal `n`: its collision radius, or, for a

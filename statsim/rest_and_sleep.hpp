@@ -129,8 +129,11 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const Scalar w2 = turning ? Scalar(0) : squared_norm(b.angular_velocity) * r2;
     const Scalar speed2 = v2 > w2 ? v2 : w2;
     const bool settling = b.touching && speed2 < settle2;
+    // A body carried by another (`Body::supported`) takes its pose against up: piles stand on
+    // near-level ground.
+    const bool carried = b.on_ground || b.supported;
     const Vec ground = settling && b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
-    update_rest_pose(w, b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt, ground);
+    update_rest_pose(w, b, settling && carried, settling && !carried, speed2 >= settle2, dt, ground);
     if (!settling) {
       b.state = MotionState::moving;
       b.slow_time = 0;
@@ -143,9 +146,9 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     // never moves and never sleeps (tools/ref2d/README.md shows how often in a pile).
     const Scalar moved2 = (b.position - b.step_start).squaredNorm();
     const Scalar lin2 = moved2 < v2 * dt * dt ? moved2 / (dt * dt) : v2;
-    // It turns at ground contacts only: one that keeps its pose while held up by other bodies
-    // cannot reach it there, and may sleep where it is.
-    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (!turning || !b.on_ground || in_rest_pose(w, b, ground));
+    // It turns at ground contacts and, with hull contacts, on bodies that carry it: one that
+    // keeps its pose while held up otherwise cannot reach it there, and may sleep where it is.
+    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (!turning || !carried || in_rest_pose(w, b, ground));
     b.slow_time = still ? b.slow_time + dt : 0;
     if (still && b.slow_time >= def.sleep_time) {
       b.state = MotionState::asleep;

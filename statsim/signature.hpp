@@ -233,12 +233,17 @@ struct RestPosesView {
 ///    face f = 2 m + (u_m < 0) for u's largest component m (the first of equals), value
 ///    (f S + i) S + j (2D: f S + i). It is never below the hull's support, so two bodies placed
 ///    by it never overlap their hulls;
-///  - the hull's largest faces (2D: edges), largest first: outward unit normal in the body frame
-///    and its distance from the centre of mass, m;
+///  - the hull's largest faces (2D: edges), largest first: outward unit normal in the body frame,
+///    its distance from the centre of mass (m), and the packing ratio of contacts along it;
 ///  - packing: centre distance of touching neighbours in reference piles over the distance
-///    their hulls allow along the line of centres, mean and standard deviation, for lines of
-///    centres 0-30, 30-60 and 60-90 degrees from the vertical (1 for convex shapes; below 1 where
-///    concave shapes nest).
+///    their hulls allow along the line of centres (1 for convex shapes; below 1 where concave
+///    shapes nest). Per face, over the pairs whose hull contact is along that face (a face of
+///    the shape itself holds a neighbour at its hull, ratio 1; a hull face across a hollow lets
+///    it in); and, for pairs touching along their line of centres, mean and standard deviation
+///    for lines of centres 0-30, 30-60 and 60-90 degrees from the vertical.
+/// Numbers stored per hull face: D of the unit normal, the offset, the packing ratio.
+constexpr std::uint32_t face_values(int d) { return std::uint32_t(d) + 2; }
+
 /// Most support map nodes a side that the runtime takes (65: a 3D map of 25,350 values).
 constexpr std::uint32_t max_support_size = 65;
 /// Most hull faces a table may give for body-body contacts; each is a candidate normal, so
@@ -251,7 +256,7 @@ struct ContactView {
   ValuesView support;              ///< m, 6 S^2 values (2D: 4 S)
   const Scalar* pair_mean = nullptr;    ///< m, one per h_coll axis sample
   const Scalar* pair_stddev = nullptr;  ///< m
-  const Scalar* faces = nullptr;        ///< D + 1 numbers per face: unit normal, offset (m)
+  const Scalar* faces = nullptr;  ///< `face_values(D)` numbers per face: unit normal, offset (m), packing ratio
   std::uint32_t face_count = 0;
   std::array<Scalar, 3> packing_mean{};    ///< ratio, by angle of the line of centres
   std::array<Scalar, 3> packing_stddev{};  ///< ratio
@@ -433,7 +438,7 @@ constexpr SignatureView<D> signature_view(const S& s)
     v.contact.pair_mean = c.pair_mean.size() > 0 ? c.pair_mean.data() : nullptr;
     v.contact.pair_stddev = c.pair_stddev.size() > 0 ? c.pair_stddev.data() : nullptr;
     v.contact.faces = c.faces.size() > 0 ? c.faces.data() : nullptr;
-    v.contact.face_count = static_cast<std::uint32_t>(c.faces.size() / (D + 1));
+    v.contact.face_count = static_cast<std::uint32_t>(c.faces.size() / face_values(D));
     for (std::size_t k = 0; k < 3; ++k) {
       v.contact.packing_mean[k] = c.packing_mean[k];
       v.contact.packing_stddev[k] = c.packing_stddev[k];
@@ -455,7 +460,7 @@ struct BasicContactData {
   std::array<Scalar, NH> pair_mean;    ///< m
   std::array<Scalar, NH> pair_stddev;  ///< m
   Support support;                     ///< m
-  std::array<Scalar, K * (D + 1)> faces;
+  std::array<Scalar, K * face_values(D)> faces;
   std::array<Scalar, 3> packing_mean;
   std::array<Scalar, 3> packing_stddev;
 };

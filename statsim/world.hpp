@@ -66,7 +66,7 @@ class WorldCore {
     if (s != Status::ok) return {s, 0};
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, 0};
     w_.shapes[w_.shape_count] =
-        Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius, 0, def.radius};
+        Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius, 0, def.radius, 1};
     return {Status::ok, ShapeId(w_.shape_count++)};
   }
 
@@ -100,16 +100,17 @@ class WorldCore {
     const Scalar mean_rest = weight > 0 ? weighted / weight : (rest_max > 0 ? rest_max : sig.height.mean[0]);
     // With body-body data a body also touches others as far out as its support map reaches,
     // times the largest packing ratio.
-    Scalar floor = 0;
+    Scalar floor = 0, packing = 1;
+    Shape<D>& shape = w_.shapes[w_.shape_count];
+    shape = Shape<D>{0, largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig), floor, packing};
     if (sig.contact.present()) {
       const detail::SupportBounds sb = detail::support_bounds(sig.contact);
-      Scalar packing = 1;
-      for (Scalar p : sig.contact.packing_mean) packing = p > packing ? p : packing;
-      largest = sb.ceiling * packing > largest ? sb.ceiling * packing : largest;
-      floor = sb.floor;
+      packing = detail::largest_packing(shape);
+      const Scalar reach = sb.ceiling * (packing > 1 ? packing : Scalar(1));
+      shape.bounding_radius = reach > largest ? reach : largest;
+      shape.support_floor = sb.floor;
+      shape.largest_packing = packing;
     }
-    Shape<D>& shape = w_.shapes[w_.shape_count];
-    shape = Shape<D>{0, largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig), floor};
     rest_basin_biases<D>(sig, shape.rest_bias.data());
     return {Status::ok, ShapeId(w_.shape_count++)};
   }
@@ -157,6 +158,7 @@ class WorldCore {
     b.state = def.asleep ? MotionState::asleep : MotionState::moving;
     b.touching = false;
     b.on_ground = false;
+    b.supported = false;
     b.rest_pose = no_rest_pose;
     b.pile_rest = false;
     b.rest_blend = 0;

@@ -170,10 +170,11 @@ Status check_signature_values(const SignatureView<D>& sig)
       if (!(c.pair_mean[i] > 0 && c.pair_mean[i] <= reach) || bad(c.pair_stddev[i]) || c.pair_stddev[i] < 0)
         return Status::invalid_shape;
   for (std::uint32_t k = 0; k < c.face_count; ++k) {
-    const Scalar* f = c.faces + k * (D + 1);
+    const Scalar* f = c.faces + k * face_values(D);
     Scalar n2 = 0;
     for (int d = 0; d < D; ++d) n2 += f[d] * f[d];
     if (!(std::fabs(n2 - 1) < Scalar(2e-3)) || !(std::fabs(f[D]) <= sig.bounding_radius)) return Status::invalid_shape;
+    if (!(f[D + 1] > 0 && f[D + 1] <= 2)) return Status::invalid_shape;
   }
   for (std::size_t k = 0; k < 3; ++k)
     if (!(c.packing_mean[k] > 0 && c.packing_mean[k] <= 2) || !(c.packing_stddev[k] >= 0 && c.packing_stddev[k] <= 2))

@@ -149,7 +149,7 @@ std::uint64_t signature_hash(const SignatureView<D>& sig)
   if (!c.present()) return h.value;
   h.add_all(c.support_size, c.face_count);
   hash_values(h, c.support, c.support_count());
-  for (std::uint32_t i = 0; i < c.face_count * (D + 1); ++i) h.add(c.faces[i]);
+  for (std::uint32_t i = 0; i < c.face_count * face_values(D); ++i) h.add(c.faces[i]);
   for (std::size_t k = 0; k < 3; ++k) h.add_all(c.packing_mean[k], c.packing_stddev[k]);
   if (c.pair_mean != nullptr)
     for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i) h.add_all(c.pair_mean[i], c.pair_stddev[i]);
@@ -170,7 +170,7 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add_vec(b.linear_velocity);
     h.add_spin(b.angular_velocity);
     h.add_all(b.radius, b.bounding_radius, b.inv_mass, b.slow_time, b.rng_state, b.rest_blend, b.shape,
-              std::uint8_t(b.state), std::uint8_t(b.touching), std::uint8_t(b.on_ground), b.rest_pose,
+              std::uint8_t(b.state), std::uint8_t(b.touching), std::uint8_t(b.on_ground | (b.supported << 1)), b.rest_pose,
               std::uint8_t(b.pile_rest));
   }
   for (std::uint32_t i = 0; i < w.plane_count; ++i) {

@@ -216,6 +216,9 @@ struct Body {
   MotionState state;
   bool touching;                          ///< touched a plane or body in the last step
   bool on_ground;                         ///< touched a near-horizontal plane in the last step
+  /// Rested on another body in the last step, along a hull contact whose normal is within 60
+  /// degrees of up (`BodyContacts::hulls`): it settles into a rest pose there as on the ground.
+  bool supported;
   std::uint8_t rest_pose;                 ///< chosen rest pose, or `no_rest_pose`
   bool pile_rest;                         ///< settling on other bodies, blending to the mean h_rest (`WorldDef::pile_rest`)
 };
@@ -251,9 +254,12 @@ struct Shape {
   /// FNV-1a hash of the signature's numbers (`detail::signature_hash`), for `state_hash`; 0 for
   /// a plain sphere.
   std::uint64_t signature_hash;
-  /// The least support the table's support map can give (`detail::support_floor`), m; 0
+  /// The least support the table's support map can give (`detail::support_bounds`), m; 0
   /// without body-body data.
   Scalar support_floor;
+  /// The largest packing ratio of the table's body-body data (`detail::largest_packing`); 1
+  /// without it.
+  Scalar largest_packing;
 };
 
 }  // namespace statsim
