@@ -88,6 +88,14 @@ struct GatherOptions {
   std::vector<double> spin_ratios = default_spin_ratios();
   std::vector<double> speeds;  ///< empty: default_paper_speeds() when with_speed
   ReferenceSettings reference;
+  // Body-body data (4.); false (--no-body-contacts): a table of format 2.0 without it.
+  bool body_contacts = true;
+  int support_size = 17;    ///< S of the support map (6 S^2 values)
+  int contact_faces = 16;   ///< largest hull faces stored (fewer when the hull has fewer)
+  int pair_trials = 400;    ///< pair flights per h_coll spin ratio
+  int packing_piles = 10;   ///< drop piles (drop_scene3 seeds 1..N)
+  int packing_bins = 2;     ///< bins of stacked bodies (seeds 1..N)
+  int packing_count = 50;   ///< bodies per pile and per bin
 };
 
 /// Checks the options; throws std::runtime_error naming the first problem.
@@ -106,6 +114,26 @@ struct RestPose {
   bool snapped = false;     ///< the normal is a hull face's (the mean was within 3 degrees of it)
   int family = 0;           ///< equivalence family under the shape's symmetry, 0 = most frequent
   double family_frequency = 0.0;  ///< the family's summed frequency
+};
+
+/// Body-body data of a table (4.), everything in the body frame.
+struct BodyContactResult {
+  /// Mesh frame: body point = R (mesh point - c); R row by row, then c (12 numbers).
+  std::vector<double> mesh_frame;
+  std::vector<double> pair_mean, pair_std;  ///< m, per h_coll spin ratio
+  long long pair_flights = 0;
+  int support_size = 0;
+  std::vector<double> support;  ///< m, 6 S^2 values (layout of statsim::ContactView)
+  double support_bound = 0.0;   ///< m, SupportMap3::error_bound
+  std::vector<double> faces;    ///< per face: outward unit normal, offset (m); largest first
+  int hull_faces = 0;           ///< faces of the whole hull
+  std::array<double, 3> packing_mean{{1, 1, 1}}, packing_std{{0, 0, 0}};
+  std::array<int, 3> packing_pairs{};  ///< touching pairs per angle bin
+  std::array<bool, 3> packing_pooled{};  ///< the bin had too few pairs and took all pairs' statistics
+  int total_pairs = 0;
+  int piles = 0, bins = 0, asleep = 0;  ///< piles and bins run, and how many ended all asleep
+  long long pile_steps = 0;             ///< Bullet steps over all piles and bins
+  double pair_seconds = 0.0, packing_seconds = 0.0;
 };
 
 /// One impact's normalised outcome: W+ L/|V-| (3), (V+ - V_particle+)/|V-| (3).
@@ -137,6 +165,7 @@ struct GatherResult {
   /// Extra header lines ("// Sized: ..."; "sizing" in the JSON), e.g. how --size-for-scene
   /// chose the table. Empty for a plain gathering.
   std::vector<std::string> notes;
+  BodyContactResult contact;  ///< when options.body_contacts
   // timings, s
   double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
 };
