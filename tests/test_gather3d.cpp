@@ -515,7 +515,7 @@ TEST_CASE("gather3d: a gathered box's body-body data is the closed form of a cub
   o.packing_bins = 0;
   o.packing_count = 12;
   const GatherResult r = gather(o);
-  const BodyContactResult& c = r.contact;
+  const BodyContactData& c = r.contact;
   constexpr int S = 17;
   REQUIRE(c.support_size == S);
   REQUIRE(c.support.size() == 6u * S * S);

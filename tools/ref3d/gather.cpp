@@ -40,8 +40,6 @@ constexpr std::uint64_t kCheckStream = 5;
 constexpr double kSnapDegrees = 3.0;
 // Packing bins are as wide as gather-pairs' `--bin 2.2`: walls 4.4 L apart, 2 x 2 bodies a layer.
 constexpr double kPackingBinHalfWidth = 2.2;
-// An angle bin with fewer touching pairs than this takes the statistics of all pairs.
-constexpr int kPackingMinPairs = 10;
 
 // A pool of Reference objects, one per worker at most: a task borrows one and gives it back.
 // Trials build a fresh Bullet world each, so which object runs a trial does not matter.
@@ -426,18 +424,13 @@ double packing_ratio_of(const Shape<3>& shape, const PileContact& c)
   return ab.norm() / (static_cast<double>(h.reach) / static_cast<double>(h.normal.dot(e)));
 }
 
-int angle_bin(const Eigen::Vector3d& ab)
-{
-  const double deg = std::acos(std::min(1.0, std::fabs(ab.normalized().z()))) * 180.0 / kPi;
-  return deg < 30.0 ? 0 : deg < 60.0 ? 1 : 2;
-}
-
 // 4. Body-body data (statsim::ContactView): pair distance, support map, faces, packing.
 void gather_body_contacts(GatherResult& r)
 {
   const GatherOptions& o = r.options;
   const ShapeModel& m = r.model;
-  BodyContactResult& c = r.contact;
+  BodyContactData& c = r.contact;
+  c.dims = 3;
   // Body point = R (mesh point - com), R = the principal axes' transpose: R's rows are the axes.
   const Eigen::Matrix3d& axes = m.mass.principal_axes;
   for (int i = 0; i < 3; ++i)
@@ -502,26 +495,15 @@ void gather_body_contacts(GatherResult& r)
       o.threads);
   progress.finish();
   std::array<std::vector<double>, 3> ratios;
-  std::vector<double> all;
   for (const ReferencePile& p : piles) {
     c.asleep += p.asleep ? 1 : 0;
     c.pile_steps += p.steps;
     for (const PileContact& pc : p.contacts) {
-      const double x = packing_ratio_of(shape, pc);
-      ratios[static_cast<std::size_t>(angle_bin(pc.b.position - pc.a.position))].push_back(x);
-      all.push_back(x);
+      const Eigen::Vector3d ab = pc.b.position - pc.a.position;
+      ratios[static_cast<std::size_t>(packing_bin(ab.z(), ab.norm()))].push_back(packing_ratio_of(shape, pc));
     }
   }
-  c.total_pairs = static_cast<int>(all.size());
-  const Stats pooled = stats(all.size(), [&](std::size_t i) { return all[i]; });
-  for (std::size_t b = 0; b < 3; ++b) {
-    c.packing_pairs[b] = static_cast<int>(ratios[b].size());
-    c.packing_pooled[b] = ratios[b].size() < static_cast<std::size_t>(kPackingMinPairs);
-    const Stats s = c.packing_pooled[b] ? pooled : stats(ratios[b].size(), [&](std::size_t i) { return ratios[b][i]; });
-    // Without any touching pair the hulls' own distance stands (ratio 1).
-    c.packing_mean[b] = all.empty() ? 1.0 : s.mean;
-    c.packing_std[b] = all.empty() ? 0.0 : s.std;
-  }
+  packing_statistics(ratios, c);
   c.packing_seconds = seconds_since(t1);
 }
 
@@ -935,7 +917,7 @@ std::vector<std::string> option_lines(const GatherResult& r)
 std::vector<std::string> body_contact_lines(const GatherResult& r)
 {
   const GatherOptions& o = r.options;
-  const BodyContactResult& c = r.contact;
+  const BodyContactData& c = r.contact;
   std::vector<std::string> l;
   l.push_back("support map S = " + std::to_string(c.support_size) + " (" +
               std::to_string(6 * c.support_size * c.support_size) + " values, " + (o.i16 ? "i16" : "f32") +
@@ -949,13 +931,8 @@ std::vector<std::string> body_contact_lines(const GatherResult& r)
               " bodies in Bullet, seeds 1.., until all sleep (at most 20 s at 1/240 s; " + std::to_string(c.asleep) +
               " of " + std::to_string(c.piles + c.bins) + " all asleep; " + std::to_string(c.pile_steps) +
               " Bullet steps in all); " + std::to_string(c.total_pairs) + " touching pairs");
-  const char* names[] = {"0-30", "30-60", "60-90"};
-  std::string p = "packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1):";
-  for (std::size_t b = 0; b < 3; ++b)
-    p += std::string(b ? ";" : "") + " " + names[b] + " deg " + fmt("%.4f", c.packing_mean[b]) + " +- " +
-         fmt("%.4f", c.packing_std[b]) + " (" + std::to_string(c.packing_pairs[b]) + " pairs" +
-         (c.packing_pooled[b] ? ", fewer than " + std::to_string(kPackingMinPairs) + ": all pairs' statistics" : "") +
-         ")";
+  const std::string p = "packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1):" +
+                        packing_line(c);
   l.push_back(p);
   return l;
 }
@@ -998,14 +975,13 @@ std::string header_text(const GatherResult& r, const std::string& command)
     h << "// i16 dequantization error: mean table " << fmt("%.3g", qm.worst_error) << ", spread table "
       << fmt("%.3g", qs.worst_error) << " (worst " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << ")\n";
   }
-  const BodyContactResult& c = r.contact;
+  const BodyContactData& c = r.contact;
   const bool contact = o.body_contacts;
-  const std::size_t faces = c.faces.size() / 4;
-  Quantized qsup;
   if (contact) {
-    if (o.i16) qsup = quantize(to_float(c.support));
     for (const std::string& line : body_contact_lines(r)) h << "// Body-body: " << line << "\n";
-    if (o.i16) h << "// Body-body: support map i16 dequantization error " << fmt("%.3g", qsup.worst_error) << " m\n";
+    double error = 0.0;
+    contact_entries(c, o.i16, &error);
+    if (o.i16) h << "// Body-body: support map i16 dequantization error " << fmt("%.3g", error) << " m\n";
   }
   h << table_prologue(o.name, contact ? 1 : 0);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
@@ -1014,10 +990,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
                             std::to_string(r.height_mean.size()) + ", " + std::to_string(a0) + ", " +
                             std::to_string(a1) + ", " + std::to_string(a2) + ", " + std::to_string(a3) + ", " +
                             std::to_string(r.rest.size()) + ", " + std::to_string(spread_size) +
-                            (contact ? std::string(", ") + (o.i16 ? "ContactDataQ16" : "ContactData") + "<3, " +
-                                           std::to_string(r.height_mean.size()) + ", " +
-                                           std::to_string(c.support_size) + ", " + std::to_string(faces) + ">"
-                                     : std::string()) +
+                            (contact ? ", " + contact_type(c, o.i16) : std::string()) +
                             ">",
                         o.name);
   // Short arrays on one line, long ones 8 values a line (response tables 6, one cell; normals 3).
@@ -1067,35 +1040,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << table_entry(array(normals, 3));
   h << table_entry(array(heights));
   h << table_entry(array(freqs));
-  if (contact) {
-    h << table_comment("mesh frame: body point = R (mesh point - c); R row by row, then c (m)");
-    h << table_entry(array(c.mesh_frame, 3));
-    const auto inner = [](const std::vector<double>& v, std::size_t per_line = 8) {
-      return hex_float_array(v, ArrayStyle{per_line, 8, true, 6});
-    };
-    const auto entry = [](const std::string& text, const std::string& comment = "") {
-      return "      " + text + "," + (comment.empty() ? "" : "  // " + comment) + "\n";
-    };
-    h << table_comment("body-body data (statsim::ContactView)");
-    h << "    {\n";
-    h << entry(std::to_string(c.support_size) + "u", "support map nodes a side, S");
-    h << "      // pair distance at first contact per h_coll spin ratio: mean, std (m)\n";
-    h << entry(inner(c.pair_mean));
-    h << entry(inner(c.pair_std));
-    h << "      // support map (m): face f = 2 m + (u_m < 0), value (f S + i) S + j, node -1 + 2 i / (S - 1)\n";
-    if (o.i16)
-      h << entry("{" + hex_floats({qsup.scale, qsup.offset}) + ", " + int_array(qsup.q, ArrayStyle{12, 8, false, 6}) +
-                     "}",
-                 "scale, offset, values");
-    else
-      h << entry(inner(c.support, 6));
-    h << "      // hull faces, largest first: outward unit normal (body frame), offset (m)\n";
-    h << entry(inner(c.faces, 4));
-    h << "      // packing (d / hull distance along the line of centres): mean, std at 0-30, 30-60, 60-90 deg\n";
-    h << entry(inner({c.packing_mean[0], c.packing_mean[1], c.packing_mean[2]}));
-    h << entry(inner({c.packing_std[0], c.packing_std[1], c.packing_std[2]}));
-    h << "    },\n";
-  }
+  if (contact) h << contact_entries(c, o.i16);
   h << table_epilogue();
   return h.str();
 }
@@ -1202,7 +1147,7 @@ std::string json_text(const GatherResult& r, const std::string& command)
   j["settled"] = r.settled;
   j["unsettled"] = r.unsettled;
   if (o.body_contacts) {
-    const BodyContactResult& c = r.contact;
+    const BodyContactData& c = r.contact;
     j["mesh_frame"] = fl(c.mesh_frame);
     j["body_contacts"] = {{"pair_mean", fl(c.pair_mean)},
                           {"pair_stddev", fl(c.pair_std)},
@@ -1248,7 +1193,7 @@ std::string summary_text(const GatherResult& r)
     s << "  (dropped) up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m  frequency "
       << fmt("%.3f", p.frequency) << "  family " << p.family << " (" << fmt("%.3f", p.family_frequency) << ")\n";
   if (r.options.body_contacts) {
-    const BodyContactResult& c = r.contact;
+    const BodyContactData& c = r.contact;
     s << "body-body: pair distance " << fmt("%.5f", c.pair_mean.front()) << " m at s = 0 (" << c.pair_flights
       << " flights, " << fmt("%.1f", c.pair_seconds) << " s); packing " << fmt("%.4f", c.packing_mean[0]) << ", "
       << fmt("%.4f", c.packing_mean[1]) << ", " << fmt("%.4f", c.packing_mean[2]) << " (" << c.packing_pairs[0] << ", "

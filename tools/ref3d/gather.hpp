@@ -35,6 +35,7 @@
 //    and the JSON give each pose's family and the dropped share.
 #pragma once
 
+#include "common/body_contacts.hpp"
 #include "ref3d/model.hpp"
 #include "ref3d/reference.hpp"
 #include "statsim/signature.hpp"
@@ -116,26 +117,6 @@ struct RestPose {
   double family_frequency = 0.0;  ///< the family's summed frequency
 };
 
-/// Body-body data of a table (4.), everything in the body frame.
-struct BodyContactResult {
-  /// Mesh frame: body point = R (mesh point - c); R row by row, then c (12 numbers).
-  std::vector<double> mesh_frame;
-  std::vector<double> pair_mean, pair_std;  ///< m, per h_coll spin ratio
-  long long pair_flights = 0;
-  int support_size = 0;
-  std::vector<double> support;  ///< m, 6 S^2 values (layout of statsim::ContactView)
-  double support_bound = 0.0;   ///< m, SupportMap3::error_bound
-  std::vector<double> faces;    ///< per face: outward unit normal, offset (m); largest first
-  int hull_faces = 0;           ///< faces of the whole hull
-  std::array<double, 3> packing_mean{{1, 1, 1}}, packing_std{{0, 0, 0}};
-  std::array<int, 3> packing_pairs{};  ///< touching pairs per angle bin
-  std::array<bool, 3> packing_pooled{};  ///< the bin had too few pairs and took all pairs' statistics
-  int total_pairs = 0;
-  int piles = 0, bins = 0, asleep = 0;  ///< piles and bins run, and how many ended all asleep
-  long long pile_steps = 0;             ///< Bullet steps over all piles and bins
-  double pair_seconds = 0.0, packing_seconds = 0.0;
-};
-
 /// One impact's normalised outcome: W+ L/|V-| (3), (V+ - V_particle+)/|V-| (3).
 using Response = std::array<double, 6>;
 
@@ -165,7 +146,7 @@ struct GatherResult {
   /// Extra header lines ("// Sized: ..."; "sizing" in the JSON), e.g. how --size-for-scene
   /// chose the table. Empty for a plain gathering.
   std::vector<std::string> notes;
-  BodyContactResult contact;  ///< when options.body_contacts
+  BodyContactData contact;  ///< when options.body_contacts
   // timings, s
   double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
 };
