@@ -6,8 +6,10 @@
 #include "ref3d/model.hpp"
 #include "ref3d/ref3d.hpp"
 #include "ref3d/reference.hpp"
+#include "ref3d/signature_json.hpp"
 
 #include "statsim/signature.hpp"
+#include "statsim/world_checks.hpp"
 
 #include "support/table_header.hpp"
 #include "support/temp_dir.hpp"
@@ -613,4 +615,33 @@ TEST_CASE("gather3d: --no-body-contacts writes a table of format 2.0, byte for b
   };
   CHECK(now.find("--no-body-contacts") != std::string::npos);
   CHECK(without_command(now) == without_command(old));
+}
+
+TEST_CASE("gather3d: the JSON of a table with body-body data loads with it")
+{
+  TempDir dir("gather3d_json");
+  for (const char* precision : {"f32", "i16"}) {
+    CAPTURE(precision);
+    const std::string json = dir.file(std::string("t_") + precision + ".json");
+    std::vector<std::string> args = tiny_args();
+    args.insert(args.end(), {"--precision", precision, "--out", dir.file(std::string("t_") + precision + ".hpp"),
+                             "--json", json});
+    REQUIRE(gather_cli(args) == 0);
+    const nlohmann::json j = nlohmann::json::parse(read_file(json));
+    const LoadedSignature3 s = load_signature_json(json);
+    const statsim::SignatureView<3> v = s.view();
+    REQUIRE(v.contact.present());
+    CHECK(v.contact.support_size == 17);
+    CHECK(v.contact.face_count == 6);
+    CHECK((v.contact.support.i16 != nullptr) == (std::string(precision) == "i16"));
+    REQUIRE(v.mesh_frame != nullptr);
+    CHECK(v.mesh_frame[0] == 1.0f);
+    const nlohmann::json& c = j["body_contacts"];
+    const double scale = std::string(precision) == "i16" ? static_cast<double>(v.contact.support.scale) : 0.0;
+    for (std::uint32_t k = 0; k < v.contact.support_count(); k += 97)
+      CHECK(std::fabs(v.contact.support[k] - c["support"][k].get<double>()) <= 0.5 * scale + 1e-9);
+    CHECK(v.contact.pair_mean[1] == c["pair_mean"][1].get<float>());
+    CHECK(v.contact.packing_mean[2] == c["packing_mean"][2].get<float>());
+    CHECK(statsim::detail::check_signature(v) == statsim::Status::ok);
+  }
 }
