@@ -976,7 +976,8 @@ std::string header_text(const GatherResult& r, const std::string& command)
       << fmt("%.3g", qs.worst_error) << " (worst " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << ")\n";
   }
   const BodyContactData& c = r.contact;
-  const bool contact = o.body_contacts;
+  // A result without body-body data (made by hand, or with --no-body-contacts) writes a table of format 2.0.
+  const bool contact = o.body_contacts && !r.contact.support.empty();
   if (contact) {
     for (const std::string& line : body_contact_lines(r)) h << "// Body-body: " << line << "\n";
     double error = 0.0;
@@ -1146,7 +1147,7 @@ std::string json_text(const GatherResult& r, const std::string& command)
   j["rest_drops"] = o.rest_drops;
   j["settled"] = r.settled;
   j["unsettled"] = r.unsettled;
-  if (o.body_contacts) {
+  if (o.body_contacts && !r.contact.support.empty()) {
     const BodyContactData& c = r.contact;
     j["mesh_frame"] = fl(c.mesh_frame);
     j["body_contacts"] = {{"pair_mean", fl(c.pair_mean)},
@@ -1192,7 +1193,7 @@ std::string summary_text(const GatherResult& r)
   for (const RestPose& p : r.rest_rare)
     s << "  (dropped) up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m  frequency "
       << fmt("%.3f", p.frequency) << "  family " << p.family << " (" << fmt("%.3f", p.family_frequency) << ")\n";
-  if (r.options.body_contacts) {
+  if (r.options.body_contacts && !r.contact.pair_mean.empty()) {
     const BodyContactData& c = r.contact;
     s << "body-body: pair distance " << fmt("%.5f", c.pair_mean.front()) << " m at s = 0 (" << c.pair_flights
       << " flights, " << fmt("%.1f", c.pair_seconds) << " s); packing " << fmt("%.4f", c.packing_mean[0]) << ", "

@@ -391,7 +391,7 @@ GatherResult sized_result(const GatherResult& dense, const SizingResult& s, cons
   o.height_ratios = pick(dense.options.height_ratios, hk);
   r.height_mean = pick(dense.height_mean, hk);
   r.height_std = pick(dense.height_std, hk);
-  if (o.body_contacts) {
+  if (dense.contact.pair_mean.size() == dense.options.height_ratios.size()) {
     // The pair distance lies on the h_coll axis: the same samples.
     r.contact.pair_mean = pick(dense.contact.pair_mean, hk);
     r.contact.pair_std = pick(dense.contact.pair_std, hk);
