@@ -20,17 +20,24 @@
 //   pose 1: up (1.000000, 0.000000) h_rest 0.339286 m, 622 drops, frequency 0.3110, family 0
 //   pose 2: up (0.000000, 1.000000) h_rest 0.339286 m, 590 drops, frequency 0.2950, family 0
 //   dropped: 0.0000 of the settled drops
+// body-body data: support map S = 9 (36 values; at most 0.0029 m above the hull's support), 5 of the hull's 5 edges, mesh frame: the input's frame at the centroid
+//   pair distance: 32000 pair flights (2000 per height-table spin ratio, head-on at 2 m/s relative speed, exact outlines)
+//   packing: 10 Box2D piles of 100 bodies (statsim compare2d's, seeds 1..), 900 steps of 1/60 s; 3 of 10 all asleep; 1403 touching pairs
+//   packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1): 0-30 deg 0.7916 +- 0.2319 (442 pairs); 30-60 deg 0.8576 +- 0.2101 (429 pairs); 60-90 deg 0.8785 +- 0.2036 (532 pairs)
 #pragma once
 
 #include "statsim/signature.hpp"
 
 static_assert(STATSIM_TABLE_FORMAT_VERSION == 2, "tables/lshape2d.hpp was generated for table format 2: regenerate it with the command above");
+#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 1
+#error "tables/lshape2d.hpp needs table format 2.1 (body-body data): update statsim, or regenerate the table with --no-body-contacts"
+#endif
 
 namespace statsim::tables {
 
 // Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,
 //           spread values per cell (the paper's model: one standard deviation per component)>
-inline constexpr Signature<2, 16, 7, 9, 5, 1, 3, 3> lshape2d = {
+inline constexpr Signature<2, 16, 7, 9, 5, 1, 3, 3, ContactData<2, 16, 9, 5>> lshape2d = {
     "lshape2d",
     0x1.7c4804p-1f,  // length L (bounding radius), m
     0x1.7c4804p-1f,  // bounding_radius, m
@@ -411,6 +418,45 @@ inline constexpr Signature<2, 16, 7, 9, 5, 1, 3, 3> lshape2d = {
     {{
         0x1.9374bcp-2f, 0x1.3e76c8p-2f, 0x1.2e147ap-2f
     }},
+    // mesh frame: body point = R (mesh point - c); R row by row, then c (m)
+    {{
+      0x1p+0f, 0x0p+0f,
+      0x0p+0f, 0x1p+0f,
+      0x1.5b6db6p-2f, 0x1.5b6db6p-2f
+    }},
+    // body-body data (statsim::ContactView)
+    {
+      9u,  // support map nodes a side, S
+      // pair distance at first contact per h_coll spin ratio: mean, std (m)
+      {{
+        0x1.ee0a8p-1f, 0x1.f04ep-1f, 0x1.f357c6p-1f, 0x1.fbbffcp-1f, 0x1.025b68p+0f, 0x1.0a0d46p+0f, 0x1.133706p+0f, 0x1.1c0c84p+0f,
+        0x1.22ab9ep+0f, 0x1.26dfb6p+0f, 0x1.2e228p+0f, 0x1.347edcp+0f, 0x1.3a887cp+0f, 0x1.3eaad4p+0f, 0x1.4600dcp+0f, 0x1.4adfdcp+0f
+      }},
+      {{
+        0x1.aface8p-3f, 0x1.a97324p-3f, 0x1.9e09cp-3f, 0x1.a6fd66p-3f, 0x1.83694ap-3f, 0x1.75e1dcp-3f, 0x1.52af88p-3f, 0x1.478308p-3f,
+        0x1.3850a4p-3f, 0x1.326f8ep-3f, 0x1.210f18p-3f, 0x1.1a7a9cp-3f, 0x1.13efa8p-3f, 0x1.0f74a8p-3f, 0x1.04d256p-3f, 0x1.079c52p-3f
+      }},
+      // support map (m): side f = 2 m + (u_m < 0), value f S + i, node -1 + 2 i / (S - 1)
+      {{
+        0x1p+0f, 0x1.d4924ap-1f, 0x1.a92492p-1f, 0x1.7db6dcp-1f, 0x1.524924p-1f, 0x1.46db6ep-1f,
+        0x1.3b6db6p-1f, 0x1.3p-1f, 0x1.24924ap-1f, 0x1.5b6db6p-1f, 0x1.3p-1f, 0x1.04924ap-1f,
+        0x1.b24924p-2f, 0x1.5b6db6p-2f, 0x1.024924p-1f, 0x1.56db6ep-1f, 0x1.ab6db6p-1f, 0x1p+0f,
+        0x1p+0f, 0x1.d4924ap-1f, 0x1.a92492p-1f, 0x1.7db6dcp-1f, 0x1.524924p-1f, 0x1.46db6ep-1f,
+        0x1.3b6db6p-1f, 0x1.3p-1f, 0x1.24924ap-1f, 0x1.5b6db6p-1f, 0x1.3p-1f, 0x1.04924ap-1f,
+        0x1.b24924p-2f, 0x1.5b6db6p-2f, 0x1.024924p-1f, 0x1.56db6ep-1f, 0x1.ab6db6p-1f, 0x1p+0f
+      }},
+      // hull edges, largest first: outward unit normal (body frame), offset (m)
+      {{
+        0x1.6a09e6p-1f, 0x1.6a09e6p-1f, 0x1.9dc22cp-2f,
+        0x0p+0f, -0x1p+0f, 0x1.5b6db6p-2f,
+        -0x1p+0f, 0x0p+0f, 0x1.5b6db6p-2f,
+        0x1p+0f, 0x0p+0f, 0x1.524924p-1f,
+        0x0p+0f, 0x1p+0f, 0x1.524924p-1f
+      }},
+      // packing (d / hull distance along the line of centres): mean, std at 0-30, 30-60, 60-90 deg
+      {{0x1.954d5ep-1f, 0x1.b7145ep-1f, 0x1.c1c4a2p-1f}},
+      {{0x1.dae44cp-3f, 0x1.ae4512p-3f, 0x1.a0e442p-3f}},
+    },
 };
 
 }  // namespace statsim::tables

@@ -21,17 +21,24 @@
 //   pose 2: up (0.000000, 1.000000) h_rest 0.500000 m, 482 drops, frequency 0.2410, family 0
 //   pose 3: up (0.000000, -1.000000) h_rest 0.500000 m, 481 drops, frequency 0.2405, family 0
 //   dropped: 0.0000 of the settled drops
+// body-body data: support map S = 9 (36 values; at most 0.00276 m above the hull's support), 4 of the hull's 4 edges, mesh frame: the input's frame at the centroid
+//   pair distance: 32000 pair flights (2000 per height-table spin ratio, head-on at 2 m/s relative speed, exact outlines)
+//   packing: 10 Box2D piles of 100 bodies (statsim compare2d's, seeds 1..), 900 steps of 1/60 s; 10 of 10 all asleep; 1287 touching pairs
+//   packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1): 0-30 deg 1.0151 +- 0.0017 (415 pairs); 30-60 deg 1.0152 +- 0.0017 (605 pairs); 60-90 deg 1.0157 +- 0.0018 (267 pairs)
 #pragma once
 
 #include "statsim/signature.hpp"
 
 static_assert(STATSIM_TABLE_FORMAT_VERSION == 2, "tables/square2d.hpp was generated for table format 2: regenerate it with the command above");
+#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 1
+#error "tables/square2d.hpp needs table format 2.1 (body-body data): update statsim, or regenerate the table with --no-body-contacts"
+#endif
 
 namespace statsim::tables {
 
 // Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,
 //           spread values per cell (the paper's model: one standard deviation per component)>
-inline constexpr Signature<2, 16, 7, 9, 5, 1, 4, 3> square2d = {
+inline constexpr Signature<2, 16, 7, 9, 5, 1, 4, 3, ContactData<2, 16, 9, 4>> square2d = {
     "square2d",
     0x1.6a09e6p-1f,  // length L (bounding radius), m
     0x1.6a09e6p-1f,  // bounding_radius, m
@@ -413,6 +420,44 @@ inline constexpr Signature<2, 16, 7, 9, 5, 1, 4, 3> square2d = {
     {{
         0x1.0cccccp-2f, 0x1.0624dep-2f, 0x1.ed9168p-3f, 0x1.ec8b44p-3f
     }},
+    // mesh frame: body point = R (mesh point - c); R row by row, then c (m)
+    {{
+      0x1p+0f, 0x0p+0f,
+      0x0p+0f, 0x1p+0f,
+      0x0p+0f, 0x0p+0f
+    }},
+    // body-body data (statsim::ContactView)
+    {
+      9u,  // support map nodes a side, S
+      // pair distance at first contact per h_coll spin ratio: mean, std (m)
+      {{
+        0x1.3395ecp+0f, 0x1.336d46p+0f, 0x1.328ea6p+0f, 0x1.333bb2p+0f, 0x1.3610a2p+0f, 0x1.385256p+0f, 0x1.3c43ep+0f, 0x1.40eb2ap+0f,
+        0x1.436e6ap+0f, 0x1.45809cp+0f, 0x1.477e92p+0f, 0x1.495798p+0f, 0x1.4b6c7cp+0f, 0x1.4c7532p+0f, 0x1.4e58ecp+0f, 0x1.4ff1f8p+0f
+      }},
+      {{
+        0x1.51e84ap-4f, 0x1.42c1d2p-4f, 0x1.4e9334p-4f, 0x1.51e0f4p-4f, 0x1.448548p-4f, 0x1.2a6c64p-4f, 0x1.144174p-4f, 0x1.044182p-4f,
+        0x1.fba052p-5f, 0x1.ff8772p-5f, 0x1.fdd7f4p-5f, 0x1.01bb88p-4f, 0x1.0ace54p-4f, 0x1.133c32p-4f, 0x1.16cb3p-4f, 0x1.1acfbp-4f
+      }},
+      // support map (m): side f = 2 m + (u_m < 0), value f S + i, node -1 + 2 i / (S - 1)
+      {{
+        0x1p+0f, 0x1.cp-1f, 0x1.8p-1f, 0x1.4p-1f, 0x1p-1f, 0x1.4p-1f,
+        0x1.8p-1f, 0x1.cp-1f, 0x1p+0f, 0x1p+0f, 0x1.cp-1f, 0x1.8p-1f,
+        0x1.4p-1f, 0x1p-1f, 0x1.4p-1f, 0x1.8p-1f, 0x1.cp-1f, 0x1p+0f,
+        0x1p+0f, 0x1.cp-1f, 0x1.8p-1f, 0x1.4p-1f, 0x1p-1f, 0x1.4p-1f,
+        0x1.8p-1f, 0x1.cp-1f, 0x1p+0f, 0x1p+0f, 0x1.cp-1f, 0x1.8p-1f,
+        0x1.4p-1f, 0x1p-1f, 0x1.4p-1f, 0x1.8p-1f, 0x1.cp-1f, 0x1p+0f
+      }},
+      // hull edges, largest first: outward unit normal (body frame), offset (m)
+      {{
+        0x0p+0f, -0x1p+0f, 0x1p-1f,
+        0x1p+0f, 0x0p+0f, 0x1p-1f,
+        0x0p+0f, 0x1p+0f, 0x1p-1f,
+        -0x1p+0f, 0x0p+0f, 0x1p-1f
+      }},
+      // packing (d / hull distance along the line of centres): mean, std at 0-30, 30-60, 60-90 deg
+      {{0x1.03dc52p+0f, 0x1.03e10ep+0f, 0x1.040246p+0f}},
+      {{0x1.bf3202p-10f, 0x1.b5a41ep-10f, 0x1.d99b22p-10f}},
+    },
 };
 
 }  // namespace statsim::tables

@@ -138,6 +138,15 @@ HeaderNumbers loaded_numbers(const LoadedSignature3& loaded)
         add_responses(n, s.response_mean);
         add_responses(n, s.response_spread);
         for (const std::vector<float>* v : {&s.rest_normals, &s.rest_heights, &s.rest_frequencies}) add_floats(n, *v);
+        if (s.contact.support_size == 0) return;
+        add_floats(n, s.mesh_frame);
+        n.ints.push_back(static_cast<long>(s.contact.support_size));
+        add_floats(n, s.contact.pair_mean);
+        add_floats(n, s.contact.pair_stddev);
+        add_responses(n, s.contact.support);
+        add_floats(n, s.contact.faces);
+        add_floats(n, std::vector<float>(s.contact.packing_mean.begin(), s.contact.packing_mean.end()));
+        add_floats(n, std::vector<float>(s.contact.packing_stddev.begin(), s.contact.packing_stddev.end()));
       },
       loaded.tables);
   return n;

@@ -47,6 +47,10 @@ Gather2dOptions tiny(unsigned threads)
   o.speeds = {1.5, 4.0};
   o.trials = 3;
   o.rest_drops = 20;
+  o.pair_trials = 6;
+  o.packing_piles = 1;
+  o.packing_count = 20;
+  o.packing_steps = 300;
   o.threads = threads;
   return o;
 }
@@ -451,4 +455,82 @@ TEST_CASE("compare2d: squares wedged between sleeping ones fall asleep")
   o.seed = 2;
   const Compare2dResult r = run_compare2d(o);
   CHECK(r.statsim.asleep == o.n);
+}
+
+TEST_CASE("gather2d: a gathered square's body-body data is the closed form of a square")
+{
+  Gather2dOptions o = tiny(2);
+  o.shape = "square";
+  o.packing_count = 40;
+  o.packing_steps = 600;
+  const Gather2dResult r = run_gather2d(o);
+  const BodyContactData& c = r.contact;
+  constexpr int S = 9;
+  REQUIRE(c.support_size == S);
+  REQUIRE(c.support.size() == 4u * S);
+  // A square of half side h = 0.5 m has s(u) = h (|u_x| + |u_y|): h (1 + |a|) at side node a.
+  for (int f = 0; f < 4; ++f)
+    for (int i = 0; i < S; ++i)
+      CHECK(c.support[static_cast<std::size_t>(f * S + i)] ==
+            doctest::Approx(0.5 * (1 + std::fabs(-1.0 + 2.0 * i / (S - 1)))).epsilon(1e-9));
+  // Its four edges, each axis direction once, 0.5 m from the centre.
+  REQUIRE(c.hull_faces == 4);
+  REQUIRE(c.faces.size() == 4u * 3u);
+  std::vector<int> seen(4, 0);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const double x = c.faces[3 * k], y = c.faces[3 * k + 1];
+    CHECK(std::hypot(x, y) == doctest::Approx(1.0));
+    const int axis = std::fabs(y) > std::fabs(x) ? 1 : 0;
+    CHECK(std::fabs(axis ? y : x) == doctest::Approx(1.0));
+    ++seen[static_cast<std::size_t>(2 * axis + ((axis ? y : x) < 0 ? 1 : 0))];
+    CHECK(c.faces[3 * k + 2] == doctest::Approx(0.5));
+  }
+  CHECK(seen == std::vector<int>(4, 1));
+  REQUIRE(c.mesh_frame.size() == 6);
+  CHECK(c.mesh_frame[0] == 1.0);
+  CHECK(c.mesh_frame[3] == 1.0);
+  CHECK(c.mesh_frame[1] == 0.0);
+  CHECK(c.mesh_frame[2] == 0.0);
+  // Two unit squares first touch between side to side (1 m) and corner to corner (sqrt 2 m).
+  for (double d : c.pair_mean) {
+    CHECK(d > 1.0);
+    CHECK(d < std::sqrt(2.0));
+  }
+  // Resting squares stand where their hulls touch, plus Box2D's polygon skins (2 x 0.01 m).
+  REQUIRE(c.total_pairs > 0);
+  for (std::size_t b = 0; b < 3; ++b) {
+    CHECK(c.packing_mean[b] > 0.99);
+    CHECK(c.packing_mean[b] < 1.04);
+  }
+}
+
+TEST_CASE("gather2d: body-body data adds its parts and changes no other byte; the runtime accepts it")
+{
+  const std::string command = "build/bin/statsim gather2d --shape lshape --out tables/tiny2d.hpp";
+  const Gather2dResult with = run_gather2d(tiny(2));
+  Gather2dOptions o = tiny(2);
+  o.body_contacts = false;
+  const std::string without = gather2d_header(run_gather2d(o), command);
+  Gather2dResult stripped = with;
+  stripped.options.body_contacts = false;
+  CHECK(gather2d_header(stripped, command) == without);
+  CHECK(without.find("ContactData") == std::string::npos);
+  CHECK(without.find("STATSIM_TABLE_FORMAT_MINOR") == std::string::npos);
+  const std::string text = gather2d_header(with, command);
+  CHECK(text.find(", ContactData<2, 3, 9, 5>> tiny2d = {") != std::string::npos);
+  CHECK(text.find("#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 1\n#error ") !=
+        std::string::npos);
+}
+
+TEST_CASE("gather2d: the committed tables carry body-body data the runtime accepts")
+{
+  for (const statsim::SignatureView<2>& v : {statsim::tables::square2d.view(), statsim::tables::lshape2d.view()}) {
+    CAPTURE(v.name);
+    REQUIRE(v.contact.present());
+    CHECK(v.contact.support_size == 9);
+    CHECK(v.contact.face_count >= 4);
+    CHECK(v.mesh_frame != nullptr);
+    statsim::World2<4> world;
+    CHECK(world.add_shape(v).status == statsim::Status::ok);
+  }
 }

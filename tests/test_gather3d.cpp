@@ -6,8 +6,10 @@
 #include "ref3d/model.hpp"
 #include "ref3d/ref3d.hpp"
 #include "ref3d/reference.hpp"
+#include "ref3d/signature_json.hpp"
 
 #include "statsim/signature.hpp"
+#include "statsim/world_checks.hpp"
 
 #include "support/table_header.hpp"
 #include "support/temp_dir.hpp"
@@ -48,6 +50,7 @@ GatherOptions minimal_options()
   o.cos_phi = {0.0};
   o.spin_ratios = {0.0};
   o.threads = 2;
+  o.body_contacts = false;
   return o;
 }
 
@@ -55,7 +58,8 @@ GatherOptions minimal_options()
 std::vector<std::string> tiny_args()
 {
   return {"--shape", "box", "--cos-theta", "0.5,1", "--cos-phi", "-1,1", "--spin-ratios", "0,1", "--height-ratios",
-          "0,1,4", "--trials", "3", "--height-trials", "8", "--rest-drops", "24", "--quiet"};
+          "0,1,4", "--trials", "3", "--height-trials", "8", "--rest-drops", "24", "--pair-trials", "4",
+          "--packing-piles", "1", "--packing-bins", "1", "--packing-count", "12", "--quiet"};
 }
 
 int gather_cli(std::vector<std::string> args, std::string* err_text = nullptr)
@@ -321,6 +325,10 @@ TEST_CASE("gather3d: the same command and seed give the same bytes with 1 or 2 t
     for (const auto& p : j["rest"]) append(expect, p["normal"]);
     for (const auto& p : j["rest"]) expect.push_back(p["height"].get<double>());
     for (const auto& p : j["rest"]) expect.push_back(p["frequency"].get<double>());
+    append(expect, j["mesh_frame"]);
+    const nlohmann::json& c = j["body_contacts"];
+    for (const char* key : {"pair_mean", "pair_stddev", "support", "faces", "packing_mean", "packing_stddev"})
+      append(expect, c[key]);
     const HeaderNumbers h = header_numbers(header1);
     REQUIRE(h.floats.size() == expect.size());
     for (std::size_t i = 0; i < expect.size(); ++i) CHECK(h.floats[i] == expect[i]);
@@ -330,7 +338,7 @@ TEST_CASE("gather3d: the same command and seed give the same bytes with 1 or 2 t
     CHECK(j["h_coll"]["mean"].size() == 3);
     CHECK(j["inertia"].size() == 3);
     CHECK(j["rest"].size() >= 1);
-    CHECK(h.ints == std::vector<long>{3});  // axis_count "3u"
+    CHECK(h.ints == std::vector<long>{3, 17});  // axis_count "3u", support map size "17u"
   }
 }
 
@@ -339,7 +347,7 @@ TEST_CASE("gather3d: i16 tables dequantize within the reported error")
   TempDir dir("gather3d");
   const std::string out = dir.file("tiny16.hpp"), json = dir.file("tiny16.json");
   std::vector<std::string> args = tiny_args();
-  args.insert(args.end(), {"--precision", "i16", "--out", out, "--json", json});
+  args.insert(args.end(), {"--precision", "i16", "--no-body-contacts", "--out", out, "--json", json});
   REQUIRE(gather_cli(args) == 0);
   const std::string text = read_file(out);
   CHECK(text.find("SignatureQ16<3, 3, 2, 2, 2, 1,") != std::string::npos);
@@ -495,5 +503,145 @@ TEST_CASE("gather3d: the committed lshape and bunny tables")
     }
     CHECK(total <= 1.0f + 1e-6f);
     CHECK(v.height.mean[0] < v.bounding_radius);
+  }
+}
+
+TEST_CASE("gather3d: a gathered box's body-body data is the closed form of a cube")
+{
+  GatherOptions o = minimal_options();
+  o.rest_drops = 4;
+  o.height_ratios = {0.0, 2.0};
+  o.body_contacts = true;
+  o.pair_trials = 8;
+  o.packing_piles = 1;
+  o.packing_bins = 0;
+  o.packing_count = 12;
+  const GatherResult r = gather(o);
+  const BodyContactData& c = r.contact;
+  constexpr int S = 17;
+  REQUIRE(c.support_size == S);
+  REQUIRE(c.support.size() == 6u * S * S);
+  // A cube of half extent h = 0.1 m has s(u) = h (|u_x| + |u_y| + |u_z|), so every face of the
+  // map holds h (1 + |a| + |b|) at its node (a, b).
+  const auto node = [](int i) { return -1.0 + 2.0 * i / (S - 1); };
+  for (int f = 0; f < 6; ++f)
+    for (int i = 0; i < S; ++i)
+      for (int j = 0; j < S; ++j)
+        CHECK(c.support[static_cast<std::size_t>((f * S + i) * S + j)] ==
+              doctest::Approx(0.1 * (1 + std::fabs(node(i)) + std::fabs(node(j)))).epsilon(1e-9));
+  // Its six faces, each axis direction once, 0.1 m from the centre.
+  REQUIRE(c.hull_faces == 6);
+  REQUIRE(c.faces.size() == 6u * 4u);
+  std::vector<int> seen(6, 0);
+  for (std::size_t k = 0; k < 6; ++k) {
+    const Eigen::Vector3d n(c.faces[4 * k], c.faces[4 * k + 1], c.faces[4 * k + 2]);
+    CHECK(n.norm() == doctest::Approx(1.0));
+    CHECK(n.cwiseAbs().maxCoeff() == doctest::Approx(1.0));
+    Eigen::Index axis = 0;
+    n.cwiseAbs().maxCoeff(&axis);
+    ++seen[static_cast<std::size_t>(2 * axis + (n[axis] < 0 ? 1 : 0))];
+    CHECK(c.faces[4 * k + 3] == doctest::Approx(0.1));
+  }
+  CHECK(seen == std::vector<int>(6, 1));
+  // The box mesh is centred on its centre of mass, along its axes: the identity frame.
+  const std::vector<double> identity = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  REQUIRE(c.mesh_frame.size() == identity.size());
+  for (std::size_t k = 0; k < identity.size(); ++k) CHECK(c.mesh_frame[k] == doctest::Approx(identity[k]));
+  // Two cubes first touch between face to face (2 h) and corner to corner (2 sqrt(3) h).
+  REQUIRE(c.pair_mean.size() == 2);
+  for (double d : c.pair_mean) {
+    CHECK(d > 0.2);
+    CHECK(d < 0.2 * std::sqrt(3.0));
+  }
+  // A convex shape's resting neighbours stand where their hulls touch: ratios near 1.
+  for (std::size_t b = 0; b < 3; ++b) {
+    CHECK(c.packing_mean[b] == doctest::Approx(1.0).epsilon(0.03));
+    CHECK(c.packing_std[b] >= 0.0);
+  }
+}
+
+TEST_CASE("gather3d: a header with body-body data compiles, and add_shape accepts it")
+{
+  TempDir dir("gather3d_contacts");
+  for (const char* precision : {"f32", "i16"}) {
+    std::vector<std::string> args = tiny_args();
+    args.insert(args.end(), {"--precision", precision, "--name", std::string("t_") + precision, "--out",
+                             dir.file(std::string("t_") + precision + ".hpp")});
+    REQUIRE(gather_cli(args) == 0);
+    const std::string text = read_file(dir.file(std::string("t_") + precision + ".hpp"));
+    CHECK(text.find(std::string(precision) == "i16" ? "ContactDataQ16<3, 3, 17, 6>>" : "ContactData<3, 3, 17, 6>>") !=
+          std::string::npos);
+    CHECK(text.find("#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 1\n#error ") !=
+          std::string::npos);
+  }
+  const std::string program = dir.write("add_shape.cpp", "#include \"t_f32.hpp\"\n#include \"t_i16.hpp\"\n"
+                                                         "#include \"statsim/world3.hpp\"\n#include <memory>\n"
+                                                         "int main()\n{\n"
+                                                         "  auto w = std::make_unique<statsim::World3<4>>(statsim::WorldDef3{});\n"
+                                                         "  int bad = 0;\n"
+                                                         "  for (const statsim::SignatureView<3>& v : {statsim::tables::t_f32.view(), statsim::tables::t_i16.view()})\n"
+                                                         "    bad += v.contact.present() && w->add_shape(v).ok() ? 0 : 1;\n"
+                                                         "  return bad;\n}\n");
+  const std::string exe = dir.file("add_shape");
+  const std::string compile = std::string(STATSIM_TEST_CXX) + " -std=c++17 -O0 -Wall -Wextra -Wmissing-braces -Werror -I" +
+                              STATSIM_TEST_SOURCE_DIR + " -isystem " + STATSIM_TEST_EIGEN_INCLUDE + " " + program +
+                              " -o " + exe;
+  REQUIRE(std::system(compile.c_str()) == 0);
+  CHECK(std::system(exe.c_str()) == 0);
+}
+
+TEST_CASE("gather3d: --no-body-contacts writes a table of format 2.0, byte for byte")
+{
+  // The box table as committed before body-body data (tests/support/format_2_0_box.hpp), from its
+  // own command with --no-body-contacts: every line but the command is the same.
+  const std::string old = read_file(std::string(STATSIM_TEST_SOURCE_DIR) + "/tests/support/format_2_0_box.hpp");
+  const std::string prefix = "// command: build/bin/statsim gather ";
+  const std::size_t at = old.find(prefix);
+  REQUIRE(at != std::string::npos);
+  const std::string line = old.substr(at + prefix.size(), old.find('\n', at) - at - prefix.size());
+  std::vector<std::string> args;
+  std::istringstream words(line);
+  for (std::string w; words >> w;) args.push_back(w);
+  TempDir dir("gather3d_v20");
+  const auto out = std::find(args.begin(), args.end(), "--out");
+  REQUIRE(out != args.end());
+  *(out + 1) = dir.file("box.hpp");
+  args.insert(args.end(), {"--no-body-contacts", "--quiet"});
+  REQUIRE(gather_cli(args) == 0);
+  const std::string now = read_file(dir.file("box.hpp"));
+  const auto without_command = [](const std::string& t) {
+    const std::size_t a = t.find("// command: "), b = t.find('\n', a);
+    return t.substr(0, a) + t.substr(b);
+  };
+  CHECK(now.find("--no-body-contacts") != std::string::npos);
+  CHECK(without_command(now) == without_command(old));
+}
+
+TEST_CASE("gather3d: the JSON of a table with body-body data loads with it")
+{
+  TempDir dir("gather3d_json");
+  for (const char* precision : {"f32", "i16"}) {
+    CAPTURE(precision);
+    const std::string json = dir.file(std::string("t_") + precision + ".json");
+    std::vector<std::string> args = tiny_args();
+    args.insert(args.end(), {"--precision", precision, "--out", dir.file(std::string("t_") + precision + ".hpp"),
+                             "--json", json});
+    REQUIRE(gather_cli(args) == 0);
+    const nlohmann::json j = nlohmann::json::parse(read_file(json));
+    const LoadedSignature3 s = load_signature_json(json);
+    const statsim::SignatureView<3> v = s.view();
+    REQUIRE(v.contact.present());
+    CHECK(v.contact.support_size == 17);
+    CHECK(v.contact.face_count == 6);
+    CHECK((v.contact.support.i16 != nullptr) == (std::string(precision) == "i16"));
+    REQUIRE(v.mesh_frame != nullptr);
+    CHECK(v.mesh_frame[0] == 1.0f);
+    const nlohmann::json& c = j["body_contacts"];
+    const double scale = std::string(precision) == "i16" ? static_cast<double>(v.contact.support.scale) : 0.0;
+    for (std::uint32_t k = 0; k < v.contact.support_count(); k += 97)
+      CHECK(std::fabs(v.contact.support[k] - c["support"][k].get<double>()) <= 0.5 * scale + 1e-9);
+    CHECK(v.contact.pair_mean[1] == c["pair_mean"][1].get<float>());
+    CHECK(v.contact.packing_mean[2] == c["packing_mean"][2].get<float>());
+    CHECK(statsim::detail::check_signature(v) == statsim::Status::ok);
   }
 }

@@ -203,6 +203,14 @@ TEST_CASE("two spheres touch at the sum of their radii")
     sum += d;
   }
   CHECK(sum / n == doctest::Approx(0.2).epsilon(0.005));
+  // The pair distance `statsim gather` writes into a table (pair_distances) is the same: 2 r.
+  const PairDistances table = pair_distances(sphere, {0.0, 4.0}, 6, 2.0, 0.0005, 5, 2, false);
+  REQUIRE(table.mean.size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    CHECK(table.mean[k] == doctest::Approx(0.2).epsilon(0.005));
+    CHECK(table.std[k] < 0.002);
+  }
+  CHECK(table.flights == 12);
   // Its support is the radius in every direction, so the support estimate is 2 r too.
   const auto exact = [&](const Eigen::Vector3d& u) { return support(sphere.hull, u); };
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();

@@ -134,7 +134,8 @@ TEST_CASE("response tables: every model gathers into a table that compiles and a
   TempDir dir("response_tables");
   const std::vector<std::string> base = {"--shape", "box", "--cos-theta", "0.5,1", "--cos-phi", "-1,1",
                                          "--spin-ratios", "0,1", "--height-ratios", "0,1", "--trials", "4",
-                                         "--height-trials", "4", "--rest-drops", "12", "--quiet"};
+                                         "--height-trials", "4", "--rest-drops", "12", "--no-body-contacts",
+                                         "--quiet"};
   struct Case {
     const char* model;
     std::uint32_t spread;

@@ -51,7 +51,7 @@ std::string brace_array(const std::vector<std::string>& items, const ArrayStyle&
       s += ",";
     }
   }
-  return s + "\n    }}";
+  return s + "\n" + std::string(style.close_indent, ' ') + "}}";
 }
 
 std::string hex_float_array(const std::vector<double>& values, const ArrayStyle& style, const std::string& what)
@@ -80,13 +80,21 @@ std::string table_banner(const std::string& generator, const std::string& comman
          "\n// (run from the repository root; tools/regenerate-tables.sh regenerates every table and diffs it)\n";
 }
 
-std::string table_prologue(const std::string& name)
+std::string table_prologue(const std::string& name, int minor)
 {
   const std::string version = std::to_string(STATSIM_TABLE_FORMAT_VERSION);
-  return "#pragma once\n\n#include \"statsim/signature.hpp\"\n\n"
-         "static_assert(STATSIM_TABLE_FORMAT_VERSION == " + version + ", \"tables/" + name +
-         ".hpp was generated for table format " + version + ": regenerate it with the command above\");\n\n"
-         "namespace statsim::tables {\n\n";
+  std::string s = "#pragma once\n\n#include \"statsim/signature.hpp\"\n\n"
+                  "static_assert(STATSIM_TABLE_FORMAT_VERSION == " + version + ", \"tables/" + name +
+                  ".hpp was generated for table format " + version + ": regenerate it with the command above\");\n";
+  if (minor > 0) {
+    // A preprocessor test, not a static_assert: a runtime older than the minor format does not
+    // define the types the table names, so the compiler would stop at them first.
+    const std::string full = version + "." + std::to_string(minor);
+    s += "#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < " + std::to_string(minor) +
+         "\n#error \"tables/" + name + ".hpp needs table format " + full +
+         " (body-body data): update statsim, or regenerate the table with --no-body-contacts\"\n#endif\n";
+  }
+  return s + "\nnamespace statsim::tables {\n\n";
 }
 
 std::string table_definition(const std::string& type, const std::string& name)

@@ -27,6 +27,7 @@ struct ArrayStyle {
   std::size_t per_line = 6;    ///< values per line
   std::size_t indent = 6;      ///< spaces before the first value of a line
   bool inline_if_fits = true;  ///< at most `per_line` values: "{{a, b}}" on one line
+  std::size_t close_indent = 4;  ///< spaces before the closing "}}" of a multi-line array
 };
 
 /// A std::array initialiser "{{...}}" of already formatted items; "{}" when empty. Across
@@ -43,8 +44,9 @@ std::string int_array(const std::vector<std::int16_t>& values, const ArrayStyle&
 std::string table_banner(const std::string& generator, const std::string& command);
 
 /// From "#pragma once" to the opening of namespace statsim::tables: the include of the runtime's
-/// signature types and a static_assert that the runtime reads this table format.
-std::string table_prologue(const std::string& name);
+/// signature types and a static_assert that the runtime reads this table format; with `minor`
+/// > 0 also an #error when the runtime's minor format is older (a table with parts it lacks).
+std::string table_prologue(const std::string& name, int minor = 0);
 
 /// "inline constexpr TYPE NAME = {": the opening of the aggregate initialiser.
 std::string table_definition(const std::string& type, const std::string& name);

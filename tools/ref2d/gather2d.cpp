@@ -11,6 +11,8 @@
 #include "ref2d/box2d_util.hpp"
 #include "ref2d/compare2d.hpp"
 
+#include "common/support_map.hpp"
+#include "statsim/hull_contact.hpp"
 #include "statsim/response.hpp"
 #include "statsim/statistical.hpp"
 
@@ -515,6 +517,20 @@ void validate_gather2d_options(const Gather2dOptions& o)
   if (!(o.max_dropped >= 0.0 && o.max_dropped <= 1.0)) {
     bad("--rest-max-dropped must be in [0, 1]");
   }
+  if (o.body_contacts) {
+    if (o.support_size < 2 || o.support_size > static_cast<int>(statsim::max_support_size)) {
+      bad("--support-size must be in [2, " + std::to_string(statsim::max_support_size) + "]");
+    }
+    if (o.contact_faces < 0 || o.contact_faces > static_cast<int>(statsim::max_contact_faces)) {
+      bad("--contact-faces must be in [0, " + std::to_string(statsim::max_contact_faces) + "]");
+    }
+    if (o.pair_trials < 2) {
+      bad("--pair-trials must be at least 2");
+    }
+    if (o.packing_piles < 0 || o.packing_count < 2 || o.packing_steps < 1) {
+      bad("--packing-piles must be >= 0, --packing-count >= 2 and --packing-steps >= 1");
+    }
+  }
   const auto increasing = [&](const std::vector<double>& a, const char* what, double lo, double hi) {
     if (a.empty()) {
       bad(std::string(what) + ": need at least one value");
@@ -547,6 +563,104 @@ Gather2dResult run_rest_poses(const Gather2dOptions& options)
   rest_experiment(ctx, r);
   return r;
 }
+
+namespace {
+
+// d / (the runtime's contact distance along the line of centres) of a touching pile pair: the
+// least candidate distance that `find_hull_witness` finds on the table's own data, packing 1.
+double packing_ratio_of(const statsim::Shape<2>& shape, const Pile2dContact& c)
+{
+  statsim::Body<2> a{}, b{};
+  a.orientation = statsim::Rot2::from_angle(static_cast<statsim::Scalar>(c.angle_a));
+  b.orientation = statsim::Rot2::from_angle(static_cast<statsim::Scalar>(c.angle_b));
+  const Eigen::Vector2d ab = c.cb - c.ca;
+  const statsim::Vector2 e = ab.normalized().cast<statsim::Scalar>();
+  // Distance 0 is below any positive reach, so the search always names its best candidate.
+  std::uint32_t k = statsim::detail::find_hull_witness(shape, a, shape, b, e, statsim::Scalar(0), statsim::Scalar(1));
+  if (k == statsim::detail::no_witness) k = 0;
+  const statsim::detail::HullCandidate<2> h = statsim::detail::hull_candidate(shape, a, shape, b, e, k);
+  return ab.norm() / (static_cast<double>(h.reach) / static_cast<double>(h.normal.dot(e)));
+}
+
+// 4. Body-body data (statsim::ContactView): pair distance, support map, hull edges, packing.
+void body_contacts_experiment(const Context& ctx, Gather2dResult& r)
+{
+  const Gather2dOptions& o = r.options;
+  const Shape2& sh = ctx.shape;
+  BodyContactData& c = r.contact;
+  c.dims = 2;
+  // The body frame is the input's frame moved to its centroid, unrotated: R = I, c = offset.
+  c.mesh_frame = {1, 0, 0, 1, sh.offset.x, sh.offset.y};
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const PairDistances2d pd = pair_distances2d(sh, o.height_ratios, o.pair_trials, o.height_speed, o.seed, o.threads);
+  c.pair_mean = pd.mean;
+  c.pair_std = pd.std;
+  c.pair_flights = pd.flights;
+  c.pair_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  std::vector<Eigen::Vector2d> hull;
+  for (const Point2& p : sh.hull) hull.emplace_back(p.x, p.y);
+  const SupportMap2 map = SupportMap2::build(hull, o.support_size);
+  c.support_size = o.support_size;
+  c.support = map.values;
+  c.support_bound = map.error_bound(hull);
+  // Hull edges (counter-clockwise), longest first; equal lengths in the hull's order.
+  std::vector<std::pair<double, Eigen::Vector3d>> edges;
+  for (std::size_t k = 0; k < hull.size(); ++k) {
+    const Eigen::Vector2d d = hull[(k + 1) % hull.size()] - hull[k];
+    const Eigen::Vector2d n = Eigen::Vector2d(d.y(), -d.x()).normalized();
+    edges.emplace_back(d.norm(), Eigen::Vector3d(n.x(), n.y(), support(hull, n)));
+  }
+  std::stable_sort(edges.begin(), edges.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+  c.hull_faces = static_cast<int>(edges.size());
+  const std::size_t k = std::min(edges.size(), static_cast<std::size_t>(o.contact_faces));
+  for (std::size_t i = 0; i < k; ++i) c.faces.insert(c.faces.end(), {edges[i].second.x(), edges[i].second.y(), edges[i].second.z()});
+
+  // The table's own body-body data, as the runtime reads it from the header being written.
+  std::vector<float> support, faces;
+  for (double v : c.support) support.push_back(static_cast<float>(v) + 0.0f);
+  for (double v : c.faces) faces.push_back(static_cast<float>(v) + 0.0f);
+  statsim::SignatureView<2> view{};
+  view.contact.support_size = static_cast<std::uint32_t>(c.support_size);
+  view.contact.support = statsim::ValuesView{support.data(), nullptr, 1, 0};
+  view.contact.faces = faces.empty() ? nullptr : faces.data();
+  view.contact.face_count = static_cast<std::uint32_t>(k);
+  statsim::Shape<2> shape{};
+  shape.statistical = true;
+  shape.signature = view;
+  shape.support_floor = statsim::detail::support_bounds(view.contact).floor;
+
+  // Packing: the piles of `statsim compare2d` with this table's material.
+  const auto t1 = std::chrono::steady_clock::now();
+  statsim::SignatureView<2> material{};
+  material.material = ctx.material;
+  material.restitution_threshold = ctx.threshold;
+  c.piles = o.packing_piles;
+  std::vector<std::vector<Pile2dContact>> piles(static_cast<std::size_t>(c.piles));
+  std::vector<char> asleep(piles.size(), 0);
+  parallel_for(
+      piles.size(),
+      [&](std::size_t i) {
+        bool all = false;
+        piles[i] = box2d_pile_contacts(sh, material, o.packing_count, o.packing_steps, i + 1, all);
+        asleep[i] = all ? 1 : 0;
+      },
+      o.threads);
+  std::array<std::vector<double>, 3> ratios;
+  for (std::size_t i = 0; i < piles.size(); ++i) {
+    c.asleep += asleep[i];
+    c.pile_steps += o.packing_steps;
+    for (const Pile2dContact& pc : piles[i]) {
+      const Eigen::Vector2d ab = pc.cb - pc.ca;
+      ratios[static_cast<std::size_t>(packing_bin(ab.y(), ab.norm()))].push_back(packing_ratio_of(shape, pc));
+    }
+  }
+  packing_statistics(ratios, c);
+  c.packing_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+}
+
+}  // namespace
 
 Gather2dResult run_gather2d(const Gather2dOptions& options)
 {
@@ -637,6 +751,9 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
 
   // 3. Rest poses.
   rest_experiment(ctx, r);
+
+  // 4. Body-body data.
+  if (o.body_contacts) body_contacts_experiment(ctx, r);
   return r;
 }
 
@@ -716,12 +833,28 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
          " drops, frequency " + fmt("%.4f", c.frequency) + ", family " + std::to_string(c.family) + "\n";
   }
   s += "//   dropped: " + fmt("%.4f", r.rest_dropped) + " of the settled drops\n";
-  s += table_prologue(o.name);
+  const BodyContactData& bc = r.contact;
+  if (o.body_contacts) {
+    s += "// body-body data: support map S = " + std::to_string(bc.support_size) + " (" +
+         std::to_string(4 * bc.support_size) + " values; at most " + fmt("%.3g", bc.support_bound) +
+         " m above the hull's support), " + std::to_string(bc.face_count()) + " of the hull's " +
+         std::to_string(bc.hull_faces) + " edges, mesh frame: the input's frame at the centroid\n";
+    s += "//   pair distance: " + std::to_string(bc.pair_flights) + " pair flights (" + std::to_string(o.pair_trials) +
+         " per height-table spin ratio, head-on at " + g6(o.height_speed) + " m/s relative speed, exact outlines)\n";
+    s += "//   packing: " + std::to_string(bc.piles) + " Box2D piles of " + std::to_string(o.packing_count) +
+         " bodies (statsim compare2d's, seeds 1..), " + std::to_string(o.packing_steps) + " steps of 1/60 s; " +
+         std::to_string(bc.asleep) + " of " + std::to_string(bc.piles) + " all asleep; " +
+         std::to_string(bc.total_pairs) + " touching pairs\n";
+    s += "//   packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1):" + packing_line(bc) +
+         "\n";
+  }
+  s += table_prologue(o.name, o.body_contacts ? 1 : 0);
   s += "// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,\n"
        "//           spread values per cell (the paper's model: one standard deviation per component)>\n";
   s += table_definition("Signature<2, " + std::to_string(r.heights.size()) + ", " + std::to_string(o.cos_thetas.size()) +
                             ", " + std::to_string(o.signed_spins.size()) + ", " + std::to_string(o.speeds.size()) +
-                            ", 1, " + std::to_string(kept.size()) + ", 3>",
+                            ", 1, " + std::to_string(kept.size()) + ", 3" +
+                            (o.body_contacts ? ", " + contact_type(bc, false) : std::string()) + ">",
                         o.name);
   statsim::Material defaults;
   const auto array = [&s](const std::string& comment, const std::vector<double>& values) {
@@ -770,6 +903,7 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
   array("rest_normals: body-frame up vectors", rn);
   array("rest_heights, m", rh);
   array("rest_frequencies", rf);
+  if (o.body_contacts) s += contact_entries(bc, false);
   return s + table_epilogue();
 }
 
@@ -786,6 +920,27 @@ std::string gather2d_json(const Gather2dResult& r, const std::string& command)
   for (const HeightRow& h : r.heights)
     j["heights"].push_back({{"ratio", h.ratio}, {"mean", h.mean}, {"std", h.std}, {"min", h.min}, {"max", h.max},
                             {"trials", h.trials}, {"late", h.late}, {"missed", h.missed}});
+  if (r.options.body_contacts) {
+    const BodyContactData& c = r.contact;
+    j["mesh_frame"] = c.mesh_frame;
+    j["body_contacts"] = {{"pair_mean", c.pair_mean},
+                          {"pair_stddev", c.pair_std},
+                          {"pair_flights", c.pair_flights},
+                          {"support_size", c.support_size},
+                          {"support", c.support},
+                          {"support_bound", c.support_bound},
+                          {"faces", c.faces},
+                          {"hull_faces", c.hull_faces},
+                          {"packing_bins_deg", {0, 30, 60, 90}},
+                          {"packing_mean", c.packing_mean},
+                          {"packing_stddev", c.packing_std},
+                          {"packing_pairs", c.packing_pairs},
+                          {"packing_pooled", c.packing_pooled},
+                          {"piles", c.piles},
+                          {"pile_bodies", r.options.packing_count},
+                          {"piles_asleep", c.asleep},
+                          {"seconds", {{"pairs", c.pair_seconds}, {"packing", c.packing_seconds}}}};
+  }
   j["response_trials"] = r.response_trials;
   j["response_time_limited"] = r.response_time_limited;
   j["cells"] = nlohmann::ordered_json::array();
@@ -849,6 +1004,12 @@ std::string gather2d_summary(const Gather2dResult& r)
          ", family " + std::to_string(c.family) + ")\n";
   }
   s += "    dropped: " + fmt("%.3f", r.rest_dropped) + " of the settled drops\n";
+  if (r.options.body_contacts) {
+    const BodyContactData& c = r.contact;
+    s += "  body-body: pair distance " + fmt("%.5f", c.pair_mean.front()) + " m at s = 0 (" +
+         std::to_string(c.pair_flights) + " flights, " + fmt("%.1f", c.pair_seconds) + " s); packing" +
+         packing_line(c) + " (" + std::to_string(c.piles) + " piles, " + fmt("%.1f", c.packing_seconds) + " s)\n";
+  }
   return s;
 }
 
@@ -862,6 +1023,7 @@ struct Gather2dCommand {
   std::string json;
   std::string name;
   std::vector<std::pair<std::string, CLI::Option*>> recorded;  // options written into the command line
+  bool no_body_contacts = false;
   CLI::Option* shape_opt = nullptr;
   CLI::Option* polygon_opt = nullptr;
 };
@@ -871,6 +1033,10 @@ std::string recorded_command(const Gather2dCommand& cmd)
   std::string s = "build/bin/statsim gather2d";
   for (const auto& [flag, opt] : cmd.recorded) {
     if (opt->count() == 0) {
+      continue;
+    }
+    if (opt->get_expected_max() == 0) {  // a flag
+      s += " " + flag;
       continue;
     }
     for (const std::string& value : opt->results()) {
@@ -895,6 +1061,7 @@ void run_gather2d_command(Gather2dCommand& cmd)
     }
     const std::filesystem::path out(cmd.out);
     o.name = cmd.name.empty() ? out.stem().string() : cmd.name;
+    o.body_contacts = !cmd.no_body_contacts;
     validate_gather2d_options(o);  // fail before a long run
     const std::filesystem::path dir = out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
     if (!std::filesystem::is_directory(dir)) {
@@ -960,6 +1127,22 @@ void register_gather2d_commands(CLI::App& app)
                     "Rest poses: then keep rarer families, most frequent first, while more than this fraction of the "
                     "settled drops is in poses not kept, in [0, 1] (1: never)")
           ->capture_default_str();
+  CLI::Option* no_contacts = g->add_flag("--no-body-contacts", cmd->no_body_contacts,
+                                         "Leave out the body-body data (a table of format 2.0, as written before it existed)");
+  CLI::Option* support_size = g->add_option("--support-size", o.support_size, "Body-body: support map nodes a side, S")
+                                  ->capture_default_str();
+  CLI::Option* contact_faces =
+      g->add_option("--contact-faces", o.contact_faces, "Body-body: longest hull edges stored")->capture_default_str();
+  CLI::Option* pair_trials =
+      g->add_option("--pair-trials", o.pair_trials, "Body-body: pair flights per height-table spin ratio")
+          ->capture_default_str();
+  CLI::Option* packing_piles =
+      g->add_option("--packing-piles", o.packing_piles, "Body-body: Box2D piles for the packing ratios")
+          ->capture_default_str();
+  CLI::Option* packing_count =
+      g->add_option("--packing-count", o.packing_count, "Body-body: bodies per pile")->capture_default_str();
+  CLI::Option* packing_steps =
+      g->add_option("--packing-steps", o.packing_steps, "Body-body: steps of 1/60 s per pile")->capture_default_str();
   g->add_option("--threads", o.threads, "Worker threads (0 = all); the output does not depend on it")
       ->capture_default_str();
   g->add_option("--json", cmd->json, "Also write a JSON summary (statistics, counts, timings) to this file");
@@ -974,7 +1157,14 @@ void register_gather2d_commands(CLI::App& app)
                    {"--restitution", restitution},
                    {"--friction", friction},
                    {"--rest-min-frequency", min_frequency},
-                   {"--rest-max-dropped", max_dropped}};
+                   {"--rest-max-dropped", max_dropped},
+                   {"--no-body-contacts", no_contacts},
+                   {"--support-size", support_size},
+                   {"--contact-faces", contact_faces},
+                   {"--pair-trials", pair_trials},
+                   {"--packing-piles", packing_piles},
+                   {"--packing-count", packing_count},
+                   {"--packing-steps", packing_steps}};
   g->callback([cmd]() { run_gather2d_command(*cmd); });
 
   register_compare2d_command(app);

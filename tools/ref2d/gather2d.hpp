@@ -16,6 +16,7 @@
 //     would be in poses not kept (common/rest_families.hpp, the rule of statsim gather).
 #pragma once
 
+#include "common/body_contacts.hpp"
 #include "ref2d/fig3.hpp"
 #include "ref2d/polygon2d.hpp"
 
@@ -60,6 +61,15 @@ struct Gather2dOptions {
   double cluster_degrees = 10.0;      ///< greedy clustering tolerance
   double min_frequency = 0.05;        ///< families kept: summed frequency > this
   double max_dropped = 0.02;          ///< then rarer families kept while the dropped share exceeds this
+
+  // Body-body data (4.); false (--no-body-contacts): a table of format 2.0 without it.
+  bool body_contacts = true;
+  int support_size = 9;     ///< S of the support map (4 S values)
+  int contact_faces = 16;   ///< longest hull edges stored (fewer when the hull has fewer)
+  int pair_trials = 2000;   ///< pair flights per height-table spin ratio
+  int packing_piles = 10;   ///< Box2D piles of `statsim compare2d` (seeds 1..N)
+  int packing_count = 100;  ///< bodies per pile
+  int packing_steps = 900;  ///< steps of 1/60 s per pile
 
   unsigned threads = 0;  ///< 0 = hardware concurrency; does not change the result
   bool progress = false;
@@ -108,6 +118,7 @@ struct Gather2dResult {
   double rest_dropped = 0.0;          ///< fraction of the settled drops in poses not kept
   std::vector<Point2> rest_ups;       ///< final body-frame up vector of each drop
   std::vector<char> rest_settled;     ///< per drop: 1 = Box2D put it to sleep
+  BodyContactData contact;  ///< when options.body_contacts
   double seconds_heights = 0.0;
   double seconds_responses = 0.0;
   double seconds_rest = 0.0;
@@ -119,7 +130,7 @@ Shape2 gather2d_shape(const Gather2dOptions& options);
 /// Throws std::invalid_argument with a readable message for unusable options.
 void validate_gather2d_options(const Gather2dOptions& options);
 
-/// Runs the three experiments.
+/// Runs the three experiments, and the body-body data when options.body_contacts.
 Gather2dResult run_gather2d(const Gather2dOptions& options);
 
 /// Only the rest-pose experiment (for tests): fills rest_* and clusters.

@@ -167,43 +167,7 @@ double radial2(const Support& s, const Eigen::Matrix2d& ra, const Eigen::Matrix2
 std::vector<Pairs2dPile> run_pile(const Pairs2dOptions& o, const Shape2& shape, const SupportMap2& map,
                                   std::uint64_t seed, bool& asleep)
 {
-  const statsim::SignatureView<2> sig = table_of(o.shape);
-  Compare2dOptions co;
-  co.shape = o.shape;
-  co.n = o.n;
-  co.seed = seed;
-  const std::vector<Body2State> init = compare2d_initial_states(co, shape.bounding_radius);
-  // As `statsim compare2d`'s Box2D run.
-  b2World world(b2Vec2(0.0f, -9.81f));
-  world.SetAllowSleeping(true);
-  const std::vector<b2Body*> bodies = add_box2d_pile(world, shape, sig, init);
-  std::map<const b2Body*, std::size_t> index;
-  for (std::size_t i = 0; i < bodies.size(); ++i) index[bodies[i]] = i;
-  for (int step = 0; step < o.steps; ++step) world.Step(1.0f / 60.0f, 8, 3);
-  asleep = true;
-  for (b2Body* b : bodies) asleep = asleep && !b->IsAwake();
-  std::map<std::pair<std::size_t, std::size_t>, Eigen::Vector2d> normals, first_normal;
-  for (b2Contact* c = world.GetContactList(); c; c = c->GetNext()) {
-    if (!c->IsTouching()) continue;
-    const b2Body* ba = c->GetFixtureA()->GetBody();
-    const b2Body* bb = c->GetFixtureB()->GetBody();
-    if (ba->GetType() != b2_dynamicBody || bb->GetType() != b2_dynamicBody) continue;
-    b2WorldManifold wm;
-    c->GetWorldManifold(&wm);
-    std::size_t ia = index.at(ba), ib = index.at(bb);
-    Eigen::Vector2d n(wm.normal.x, wm.normal.y);  // from A to B
-    if (ia > ib) {
-      std::swap(ia, ib);
-      n = -n;
-    }
-    auto it = normals.find({ia, ib});
-    if (it == normals.end()) {
-      normals[{ia, ib}] = n;
-      first_normal[{ia, ib}] = n;
-    } else {
-      it->second += n;
-    }
-  }
+  const std::vector<Pile2dContact> contacts = box2d_pile_contacts(shape, table_of(o.shape), o.n, o.steps, seed, asleep);
   const std::vector<Eigen::Vector2d> hull = to_eigen(shape.hull);
   const std::vector<Eigen::Vector2d> edges = edge_normals(hull);
   std::vector<double> offsets;
@@ -211,14 +175,10 @@ std::vector<Pairs2dPile> run_pile(const Pairs2dOptions& o, const Shape2& shape, 
   const auto exact = [&](const Eigen::Vector2d& u) { return support(hull, u); };
   const auto table = [&](const Eigen::Vector2d& u) { return map.lookup(u); };
   std::vector<Pairs2dPile> out;
-  for (const auto& [key, nsum] : normals) {
-    const b2Body* ba = bodies[key.first];
-    const b2Body* bb = bodies[key.second];
-    const Eigen::Vector2d ca(ba->GetPosition().x, ba->GetPosition().y), cb(bb->GetPosition().x, bb->GetPosition().y);
-    const Eigen::Matrix2d ra = rotation(ba->GetAngle()), rb = rotation(bb->GetAngle());
-    // Contacts of two pieces can point opposite ways (nested L-shapes): then the first stands.
-    const Eigen::Vector2d ab = cb - ca, e = ab.normalized();
-    const Eigen::Vector2d n = nsum.norm() > 0.5 ? nsum.normalized() : first_normal.at(key);
+  for (const Pile2dContact& c : contacts) {
+    const Eigen::Matrix2d ra = rotation(c.angle_a), rb = rotation(c.angle_b);
+    const Eigen::Vector2d ab = c.cb - c.ca, e = ab.normalized();
+    const Eigen::Vector2d& n = c.normal;
     Pairs2dPile p;
     p.distance = ab.norm();
     p.angle_deg = std::acos(std::min(1.0, std::fabs(e.y()))) * 180.0 / kPi;
@@ -234,6 +194,87 @@ std::vector<Pairs2dPile> run_pile(const Pairs2dOptions& o, const Shape2& shape, 
 }
 
 }  // namespace
+
+std::vector<Pile2dContact> box2d_pile_contacts(const Shape2& shape, const statsim::SignatureView<2>& sig, int n,
+                                               int steps, std::uint64_t seed, bool& asleep)
+{
+  Compare2dOptions co;
+  co.n = n;
+  co.seed = seed;
+  const std::vector<Body2State> init = compare2d_initial_states(co, shape.bounding_radius);
+  // As `statsim compare2d`'s Box2D run.
+  b2World world(b2Vec2(0.0f, -9.81f));
+  world.SetAllowSleeping(true);
+  const std::vector<b2Body*> bodies = add_box2d_pile(world, shape, sig, init);
+  std::map<const b2Body*, std::size_t> index;
+  for (std::size_t i = 0; i < bodies.size(); ++i) index[bodies[i]] = i;
+  for (int step = 0; step < steps; ++step) world.Step(1.0f / 60.0f, 8, 3);
+  asleep = true;
+  for (b2Body* b : bodies) asleep = asleep && !b->IsAwake();
+  std::map<std::pair<std::size_t, std::size_t>, Eigen::Vector2d> normals, first_normal;
+  for (b2Contact* c = world.GetContactList(); c; c = c->GetNext()) {
+    if (!c->IsTouching()) continue;
+    const b2Body* ba = c->GetFixtureA()->GetBody();
+    const b2Body* bb = c->GetFixtureB()->GetBody();
+    if (ba->GetType() != b2_dynamicBody || bb->GetType() != b2_dynamicBody) continue;
+    b2WorldManifold wm;
+    c->GetWorldManifold(&wm);
+    std::size_t ia = index.at(ba), ib = index.at(bb);
+    Eigen::Vector2d nrm(wm.normal.x, wm.normal.y);  // from A to B
+    if (ia > ib) {
+      std::swap(ia, ib);
+      nrm = -nrm;
+    }
+    auto it = normals.find({ia, ib});
+    if (it == normals.end()) {
+      normals[{ia, ib}] = nrm;
+      first_normal[{ia, ib}] = nrm;
+    } else {
+      it->second += nrm;
+    }
+  }
+  std::vector<Pile2dContact> out;
+  for (const auto& [key, nsum] : normals) {
+    const b2Body* ba = bodies[key.first];
+    const b2Body* bb = bodies[key.second];
+    Pile2dContact c;
+    c.ca = Eigen::Vector2d(ba->GetPosition().x, ba->GetPosition().y);
+    c.cb = Eigen::Vector2d(bb->GetPosition().x, bb->GetPosition().y);
+    c.angle_a = ba->GetAngle();
+    c.angle_b = bb->GetAngle();
+    // Contacts of two pieces can point opposite ways (nested L-shapes): then the first stands.
+    c.normal = nsum.norm() > 0.5 ? Eigen::Vector2d(nsum.normalized()) : first_normal.at(key);
+    out.push_back(c);
+  }
+  return out;
+}
+
+PairDistances2d pair_distances2d(const Shape2& shape, const std::vector<double>& spin_ratios, int trials, double speed,
+                                 std::uint64_t seed, unsigned threads)
+{
+  const std::vector<Eigen::Vector2d> outline = to_eigen(shape.outline), hull = to_eigen(shape.hull);
+  const double L = shape.bounding_radius;
+  const std::size_t ns = spin_ratios.size(), nt = static_cast<std::size_t>(trials);
+  std::vector<double> d(ns * nt), h(ns * nt);
+  parallel_for(
+      ns * nt,
+      [&](std::size_t k) {
+        const double s = spin_ratios[k / nt];
+        d[k] = flight(outline, L, s, speed, seed, k);
+        h[k] = flight(hull, L, s, speed, seed, k);
+      },
+      threads);
+  PairDistances2d r;
+  for (std::size_t si = 0; si < ns; ++si) {
+    const std::vector<double> ds(d.begin() + si * nt, d.begin() + (si + 1) * nt);
+    const std::vector<double> hs(h.begin() + si * nt, h.begin() + (si + 1) * nt);
+    r.mean.push_back(mean_of(ds));
+    r.std.push_back(std_of(ds));
+    r.hull_mean.push_back(mean_of(hs));
+  }
+  r.flights = static_cast<long long>(ns * nt);
+  return r;
+}
 
 double pair_trial2d(const std::string& shape, double spin_ratio, std::uint64_t seed, std::uint64_t index,
                     bool hull_only)
@@ -251,25 +292,13 @@ Pairs2dResult gather_pairs2d(const Pairs2dOptions& o)
   r.options = o;
   r.bounding_radius = shape.bounding_radius;
   r.h_coll = static_cast<double>(table_of(o.shape).height.mean_at(0));
-  const std::vector<Eigen::Vector2d> outline = to_eigen(shape.outline), hull = to_eigen(shape.hull);
-  const double L = shape.bounding_radius;
+  const std::vector<Eigen::Vector2d> hull = to_eigen(shape.hull);
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t ns = o.spin_ratios.size(), nt = static_cast<std::size_t>(o.trials);
-  std::vector<double> d(ns * nt), h(ns * nt);
-  parallel_for(
-      ns * nt,
-      [&](std::size_t k) {
-        const double s = o.spin_ratios[k / nt];
-        d[k] = flight(outline, L, s, o.speed, o.seed, k);
-        h[k] = flight(hull, L, s, o.speed, o.seed, k);
-      },
-      o.threads);
-  for (std::size_t si = 0; si < ns; ++si) {
-    const std::vector<double> ds(d.begin() + si * nt, d.begin() + (si + 1) * nt);
-    const std::vector<double> hs(h.begin() + si * nt, h.begin() + (si + 1) * nt);
-    r.pair_mean.push_back(mean_of(ds));
-    r.pair_std.push_back(std_of(ds));
-    r.hull_mean.push_back(mean_of(hs));
+  {
+    const PairDistances2d pd = pair_distances2d(shape, o.spin_ratios, o.trials, o.speed, o.seed, o.threads);
+    r.pair_mean = pd.mean;
+    r.pair_std = pd.std;
+    r.hull_mean = pd.hull_mean;
   }
   r.pair_seconds = seconds_since(t0);
   for (int size : o.support_sizes) {

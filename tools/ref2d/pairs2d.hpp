@@ -14,6 +14,11 @@
 //    body), and the separation along Box2D's contact normal against the support along it.
 #pragma once
 
+#include "ref2d/polygon2d.hpp"
+#include "statsim/signature.hpp"
+
+#include <Eigen/Core>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -60,6 +65,29 @@ struct Pairs2dResult {
   int asleep = 0, bodies = 0;
   double pile_seconds = 0.0;
 };
+
+/// Pair distance at first contact (1.) per spin ratio: mean, sample standard deviation and the
+/// hulls' mean, m; `trials` flights per ratio at relative speed `speed` (m/s). Deterministic for a
+/// seed, any thread count.
+struct PairDistances2d {
+  std::vector<double> mean, std, hull_mean;
+  long long flights = 0;
+};
+PairDistances2d pair_distances2d(const Shape2& shape, const std::vector<double>& spin_ratios, int trials, double speed,
+                                 std::uint64_t seed, unsigned threads);
+
+/// A touching pair of a Box2D pile (3.): centres (m), angles (rad) and the mean contact normal
+/// from a to b (a before b by body index).
+struct Pile2dContact {
+  Eigen::Vector2d ca = Eigen::Vector2d::Zero(), cb = Eigen::Vector2d::Zero();
+  double angle_a = 0.0, angle_b = 0.0;
+  Eigen::Vector2d normal = Eigen::Vector2d::UnitY();
+};
+/// One pile of `statsim compare2d` (`n` bodies of `shape` with the material and restitution
+/// threshold of `sig`, `steps` steps of 1/60 s, initial states from `seed`): its touching pairs;
+/// `asleep` tells whether every body slept at the end.
+std::vector<Pile2dContact> box2d_pile_contacts(const Shape2& shape, const statsim::SignatureView<2>& sig, int n,
+                                               int steps, std::uint64_t seed, bool& asleep);
 
 /// Centre distance at the first contact of one pair flight (exposed for the tests): of the true
 /// outlines, or of the hulls (`hull_only`).

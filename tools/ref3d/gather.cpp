@@ -4,8 +4,11 @@
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
 #include "common/rest_families.hpp"
+#include "common/support_map.hpp"
 #include "common/table_writer.hpp"
+#include "ref3d/pairs.hpp"
 #include "ref3d/sampling.hpp"
+#include "statsim/hull_contact.hpp"
 #include "statsim/response.hpp"
 #include "statsim/signature.hpp"
 #include "statsim/statistical.hpp"
@@ -35,6 +38,8 @@ constexpr std::uint64_t kRestStream = 3;
 constexpr std::uint64_t kCheckStream = 5;
 // Rest normals within this angle of a hull face's are snapped to it.
 constexpr double kSnapDegrees = 3.0;
+// Packing bins are as wide as gather-pairs' `--bin 2.2`: walls 4.4 L apart, 2 x 2 bodies a layer.
+constexpr double kPackingBinHalfWidth = 2.2;
 
 // A pool of Reference objects, one per worker at most: a task borrows one and gives it back.
 // Trials build a fresh Bullet world each, so which object runs a trial does not matter.
@@ -192,6 +197,15 @@ void validate_gather_options(const GatherOptions& o)
   axis(o.cos_phi, "cos phi axis", -1, 1);
   axis(o.spin_ratios, "spin ratio axis", 0, 1e6);
   if (o.with_speed && !o.speeds.empty()) axis(o.speeds, "speed axis", 1e-3, 1e3);
+  if (o.body_contacts) {
+    if (o.support_size < 2 || o.support_size > static_cast<int>(max_support_size))
+      fail("--support-size must be in [2, " + std::to_string(max_support_size) + "]");
+    if (o.contact_faces < 0 || o.contact_faces > static_cast<int>(max_contact_faces))
+      fail("--contact-faces must be in [0, " + std::to_string(max_contact_faces) + "]");
+    if (o.pair_trials < 2) fail("--pair-trials must be at least 2");
+    if (o.packing_piles < 0 || o.packing_bins < 0) fail("--packing-piles and --packing-bins must be >= 0");
+    if (o.packing_count < 2) fail("--packing-count must be at least 2");
+  }
 }
 
 ShapeModel build_model(const GatherOptions& o)
@@ -380,6 +394,117 @@ std::vector<double> face_descriptor(const ShapeModel& m, const Eigen::Vector4d& 
   d.insert(d.end(), radii.begin(), radii.end());
   d.insert(d.end(), heights.begin(), heights.end());
   return d;
+}
+
+
+// The support map as the table stores it (f32, or the i16 rule) and the view the runtime reads.
+struct StoredSupport {
+  std::vector<float> values;
+  Quantized q;
+  bool i16 = false;
+  ValuesView view() const
+  {
+    return i16 ? ValuesView{nullptr, q.q.data(), q.scale, q.offset} : ValuesView{values.data(), nullptr, 1, 0};
+  }
+};
+
+// d / (the runtime's contact distance along the line of centres) of a touching pile pair: the
+// least candidate distance that `find_hull_witness` finds on the table's own data, packing 1.
+double packing_ratio_of(const Shape<3>& shape, const PileContact& c)
+{
+  Body<3> a{}, b{};
+  a.orientation = c.a.orientation.cast<Scalar>().normalized();
+  b.orientation = c.b.orientation.cast<Scalar>().normalized();
+  const Eigen::Vector3d ab = c.b.position - c.a.position;
+  const Vector3 e = ab.normalized().cast<Scalar>();
+  // Distance 0 is below any positive reach, so the search always names its best candidate.
+  std::uint32_t k = statsim::detail::find_hull_witness(shape, a, shape, b, e, Scalar(0), Scalar(1));
+  if (k == statsim::detail::no_witness) k = 0;
+  const statsim::detail::HullCandidate<3> h = statsim::detail::hull_candidate(shape, a, shape, b, e, k);
+  return ab.norm() / (static_cast<double>(h.reach) / static_cast<double>(h.normal.dot(e)));
+}
+
+// 4. Body-body data (statsim::ContactView): pair distance, support map, faces, packing.
+void gather_body_contacts(GatherResult& r)
+{
+  const GatherOptions& o = r.options;
+  const ShapeModel& m = r.model;
+  BodyContactData& c = r.contact;
+  c.dims = 3;
+  // Body point = R (mesh point - com), R = the principal axes' transpose: R's rows are the axes.
+  const Eigen::Matrix3d& axes = m.mass.principal_axes;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) c.mesh_frame.push_back(axes(j, i));
+  for (int i = 0; i < 3; ++i) c.mesh_frame.push_back(m.mass.com[i]);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const PairDistances pd =
+      pair_distances(m, o.height_ratios, o.pair_trials, o.speed, o.reference.margin, o.seed, o.threads, o.progress);
+  c.pair_mean = pd.mean;
+  c.pair_std = pd.std;
+  c.pair_flights = pd.flights;
+  c.pair_seconds = seconds_since(t0);
+
+  const SupportMap3 map = SupportMap3::build(m.hull, o.support_size);
+  c.support_size = o.support_size;
+  c.support = map.values;
+  c.support_bound = map.error_bound(m.hull);
+  const std::vector<Eigen::Vector3d> normals = faces_by_area(m);
+  const std::vector<double> offsets = face_offsets(m, normals);
+  c.hull_faces = static_cast<int>(normals.size());
+  const std::size_t k = std::min(normals.size(), static_cast<std::size_t>(o.contact_faces));
+  for (std::size_t i = 0; i < k; ++i) c.faces.insert(c.faces.end(), {normals[i].x(), normals[i].y(), normals[i].z(), offsets[i]});
+
+  // The table's own body-body data, as the runtime reads it from the header being written.
+  StoredSupport stored;
+  stored.i16 = o.i16;
+  for (double v : c.support) stored.values.push_back(static_cast<float>(v) + 0.0f);
+  if (o.i16) stored.q = quantize(stored.values);
+  std::vector<float> faces;
+  for (double v : c.faces) faces.push_back(static_cast<float>(v) + 0.0f);
+  SignatureView<3> view{};
+  view.contact.support_size = static_cast<std::uint32_t>(c.support_size);
+  view.contact.support = stored.view();
+  view.contact.faces = faces.empty() ? nullptr : faces.data();
+  view.contact.face_count = static_cast<std::uint32_t>(k);
+  Shape<3> shape{};
+  shape.statistical = true;
+  shape.signature = view;
+  shape.support_floor = statsim::detail::support_bounds(view.contact).floor;
+
+  // Packing: the reference piles and bins, then d / estimate by angle bin.
+  const auto t1 = std::chrono::steady_clock::now();
+  PairOptions drop;
+  drop.shape = o;
+  drop.pile_count = o.packing_count;
+  PairOptions bin = drop;
+  bin.bin = kPackingBinHalfWidth;
+  c.piles = o.packing_piles;
+  c.bins = o.packing_bins;
+  const std::size_t runs = static_cast<std::size_t>(c.piles + c.bins);
+  std::vector<ReferencePile> piles(runs);
+  Progress progress("packing piles", runs, o.progress);
+  parallel_for(
+      runs,
+      [&](std::size_t i) {
+        const bool is_bin = i >= static_cast<std::size_t>(c.piles);
+        const std::uint64_t seed = is_bin ? i - static_cast<std::size_t>(c.piles) + 1 : i + 1;
+        piles[i] = reference_pile(m, is_bin ? bin : drop, seed);
+        progress.add(1);
+      },
+      o.threads);
+  progress.finish();
+  std::array<std::vector<double>, 3> ratios;
+  for (const ReferencePile& p : piles) {
+    c.asleep += p.asleep ? 1 : 0;
+    c.pile_steps += p.steps;
+    for (const PileContact& pc : p.contacts) {
+      const Eigen::Vector3d ab = pc.b.position - pc.a.position;
+      ratios[static_cast<std::size_t>(packing_bin(ab.z(), ab.norm()))].push_back(packing_ratio_of(shape, pc));
+    }
+  }
+  packing_statistics(ratios, c);
+  c.packing_seconds = seconds_since(t1);
 }
 
 }  // namespace
@@ -603,6 +728,9 @@ GatherResult gather(const GatherOptions& options)
     r.rest_families = static_cast<int>(sel.family_frequency.size());
     r.rest_seconds = seconds_since(t0);
   }
+
+  // 4. Body-body data.
+  if (o.body_contacts) gather_body_contacts(r);
   return r;
 }
 
@@ -785,6 +913,30 @@ std::vector<std::string> option_lines(const GatherResult& r)
   return l;
 }
 
+// What the body-body data is and how it was measured (deterministic: no times).
+std::vector<std::string> body_contact_lines(const GatherResult& r)
+{
+  const GatherOptions& o = r.options;
+  const BodyContactData& c = r.contact;
+  std::vector<std::string> l;
+  l.push_back("support map S = " + std::to_string(c.support_size) + " (" +
+              std::to_string(6 * c.support_size * c.support_size) + " values, " + (o.i16 ? "i16" : "f32") +
+              "; at most " + fmt("%.3g", c.support_bound) + " m above the hull's support), " +
+              std::to_string(c.faces.size() / 4) + " of the hull's " + std::to_string(c.hull_faces) +
+              " faces, mesh frame from the principal axes and centre of mass");
+  l.push_back("pair distance: " + std::to_string(c.pair_flights) + " pair flights (" + std::to_string(o.pair_trials) +
+              " per h_coll spin ratio, head-on at " + num(o.speed) + " m/s relative speed)");
+  l.push_back("packing: " + std::to_string(c.piles) + " drop piles and " + std::to_string(c.bins) +
+              (c.bins == 1 ? " bin" : " bins") + " (walls " + num(2 * kPackingBinHalfWidth) + " L apart) of " + std::to_string(o.packing_count) +
+              " bodies in Bullet, seeds 1.., until all sleep (at most 20 s at 1/240 s; " + std::to_string(c.asleep) +
+              " of " + std::to_string(c.piles + c.bins) + " all asleep; " + std::to_string(c.pile_steps) +
+              " Bullet steps in all); " + std::to_string(c.total_pairs) + " touching pairs");
+  const std::string p = "packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1):" +
+                        packing_line(c);
+  l.push_back(p);
+  return l;
+}
+
 }  // namespace
 
 std::string header_text(const GatherResult& r, const std::string& command)
@@ -823,13 +975,24 @@ std::string header_text(const GatherResult& r, const std::string& command)
     h << "// i16 dequantization error: mean table " << fmt("%.3g", qm.worst_error) << ", spread table "
       << fmt("%.3g", qs.worst_error) << " (worst " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << ")\n";
   }
-  h << table_prologue(o.name);
+  const BodyContactData& c = r.contact;
+  // A result without body-body data (made by hand, or with --no-body-contacts) writes a table of format 2.0.
+  const bool contact = o.body_contacts && !r.contact.support.empty();
+  if (contact) {
+    for (const std::string& line : body_contact_lines(r)) h << "// Body-body: " << line << "\n";
+    double error = 0.0;
+    contact_entries(c, o.i16, &error);
+    if (o.i16) h << "// Body-body: support map i16 dequantization error " << fmt("%.3g", error) << " m\n";
+  }
+  h << table_prologue(o.name, contact ? 1 : 0);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
                     a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
   h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
                             std::to_string(r.height_mean.size()) + ", " + std::to_string(a0) + ", " +
                             std::to_string(a1) + ", " + std::to_string(a2) + ", " + std::to_string(a3) + ", " +
-                            std::to_string(r.rest.size()) + ", " + std::to_string(spread_size) + ">",
+                            std::to_string(r.rest.size()) + ", " + std::to_string(spread_size) +
+                            (contact ? ", " + contact_type(c, o.i16) : std::string()) +
+                            ">",
                         o.name);
   // Short arrays on one line, long ones 8 values a line (response tables 6, one cell; normals 3).
   const auto array = [](const std::vector<double>& v, std::size_t per_line = 8) {
@@ -878,6 +1041,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << table_entry(array(normals, 3));
   h << table_entry(array(heights));
   h << table_entry(array(freqs));
+  if (contact) h << contact_entries(c, o.i16);
   h << table_epilogue();
   return h.str();
 }
@@ -983,6 +1147,28 @@ std::string json_text(const GatherResult& r, const std::string& command)
   j["rest_drops"] = o.rest_drops;
   j["settled"] = r.settled;
   j["unsettled"] = r.unsettled;
+  if (o.body_contacts && !r.contact.support.empty()) {
+    const BodyContactData& c = r.contact;
+    j["mesh_frame"] = fl(c.mesh_frame);
+    j["body_contacts"] = {{"pair_mean", fl(c.pair_mean)},
+                          {"pair_stddev", fl(c.pair_std)},
+                          {"pair_flights", c.pair_flights},
+                          {"support_size", c.support_size},
+                          {"support", fl(c.support)},
+                          {"support_bound", c.support_bound},
+                          {"faces", fl(c.faces)},
+                          {"hull_faces", c.hull_faces},
+                          {"packing_bins_deg", {0, 30, 60, 90}},
+                          {"packing_mean", fl({c.packing_mean[0], c.packing_mean[1], c.packing_mean[2]})},
+                          {"packing_stddev", fl({c.packing_std[0], c.packing_std[1], c.packing_std[2]})},
+                          {"packing_pairs", {c.packing_pairs[0], c.packing_pairs[1], c.packing_pairs[2]}},
+                          {"packing_pooled", {c.packing_pooled[0], c.packing_pooled[1], c.packing_pooled[2]}},
+                          {"piles", c.piles},
+                          {"bins", c.bins},
+                          {"pile_bodies", o.packing_count},
+                          {"piles_asleep", c.asleep},
+                          {"pile_steps", c.pile_steps}};
+  }
   return j.dump(2) + "\n";
 }
 
@@ -1007,6 +1193,14 @@ std::string summary_text(const GatherResult& r)
   for (const RestPose& p : r.rest_rare)
     s << "  (dropped) up " << vec3(p.normal, "%+.4f") << "  h_rest " << fmt("%.5f", p.height) << " m  frequency "
       << fmt("%.3f", p.frequency) << "  family " << p.family << " (" << fmt("%.3f", p.family_frequency) << ")\n";
+  if (r.options.body_contacts && !r.contact.pair_mean.empty()) {
+    const BodyContactData& c = r.contact;
+    s << "body-body: pair distance " << fmt("%.5f", c.pair_mean.front()) << " m at s = 0 (" << c.pair_flights
+      << " flights, " << fmt("%.1f", c.pair_seconds) << " s); packing " << fmt("%.4f", c.packing_mean[0]) << ", "
+      << fmt("%.4f", c.packing_mean[1]) << ", " << fmt("%.4f", c.packing_mean[2]) << " (" << c.packing_pairs[0] << ", "
+      << c.packing_pairs[1] << ", " << c.packing_pairs[2] << " pairs; " << c.piles << " piles, " << c.bins << " bins, "
+      << fmt("%.1f", c.packing_seconds) << " s)\n";
+  }
   if (r.options.i16) {
     const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));
     s << "i16: worst dequantization error " << fmt("%.3g", std::max(qm.worst_error, qs.worst_error)) << "\n";

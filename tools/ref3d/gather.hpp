@@ -35,6 +35,7 @@
 //    and the JSON give each pose's family and the dropped share.
 #pragma once
 
+#include "common/body_contacts.hpp"
 #include "ref3d/model.hpp"
 #include "ref3d/reference.hpp"
 #include "statsim/signature.hpp"
@@ -88,6 +89,14 @@ struct GatherOptions {
   std::vector<double> spin_ratios = default_spin_ratios();
   std::vector<double> speeds;  ///< empty: default_paper_speeds() when with_speed
   ReferenceSettings reference;
+  // Body-body data (4.); false (--no-body-contacts): a table of format 2.0 without it.
+  bool body_contacts = true;
+  int support_size = 17;    ///< S of the support map (6 S^2 values)
+  int contact_faces = 16;   ///< largest hull faces stored (fewer when the hull has fewer)
+  int pair_trials = 400;    ///< pair flights per h_coll spin ratio
+  int packing_piles = 10;   ///< drop piles (drop_scene3 seeds 1..N)
+  int packing_bins = 2;     ///< bins of stacked bodies (seeds 1..N)
+  int packing_count = 50;   ///< bodies per pile and per bin
 };
 
 /// Checks the options; throws std::runtime_error naming the first problem.
@@ -137,6 +146,7 @@ struct GatherResult {
   /// Extra header lines ("// Sized: ..."; "sizing" in the JSON), e.g. how --size-for-scene
   /// chose the table. Empty for a plain gathering.
   std::vector<std::string> notes;
+  BodyContactData contact;  ///< when options.body_contacts
   // timings, s
   double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
 };

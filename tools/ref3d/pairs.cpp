@@ -437,6 +437,40 @@ struct PileOutcome {
 
 PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap3& map, std::uint64_t seed)
 {
+  const ReferencePile pile = reference_pile(m, o, seed);
+  PileOutcome out;
+  out.bodies = pile.bodies;
+  out.asleep = pile.asleep;
+  const std::vector<Eigen::Vector3d> faces = faces_by_area(m);
+  const std::vector<double> offsets = face_offsets(m, faces);
+  for (const PileContact& c : pile.contacts) {
+    const Eigen::Vector3d& n = c.normal;
+    const Eigen::Vector3d ab = c.b.position - c.a.position;
+    const Eigen::Vector3d e = ab.normalized();
+    const Eigen::Matrix3d ra = c.a.orientation.toRotationMatrix(), rb = c.b.orientation.toRotationMatrix();
+    PilePair p;
+    p.distance = ab.norm();
+    p.angle_deg = std::acos(std::min(1.0, std::fabs(e.z()))) * 180.0 / kPi;
+    p.along_normal = ab.dot(n);
+    p.support_e = support(m.hull, ra.transpose() * e) + support(m.hull, -(rb.transpose() * e));
+    p.support_e_map = map.lookup(ra.transpose() * e) + map.lookup(-(rb.transpose() * e));
+    p.support_n = support(m.hull, ra.transpose() * n) + support(m.hull, -(rb.transpose() * n));
+    p.penetration = c.penetration;
+    const auto exact = [&](const Eigen::Vector3d& u) { return support(m.hull, u); };
+    const auto table = [&](const Eigen::Vector3d& u) { return map.lookup(u); };
+    p.radial6 = radial_estimate(exact, ra, rb, e, faces, 6);
+    p.radial16 = radial_estimate(exact, ra, rb, e, faces, 16);
+    p.radial_all = radial_estimate(exact, ra, rb, e, faces, faces.size());
+    p.radial_map = radial_estimate(table, ra, rb, e, faces, static_cast<std::size_t>(o.candidate_faces), &offsets);
+    out.pairs.push_back(p);
+  }
+  return out;
+}
+
+}  // namespace
+
+ReferencePile reference_pile(const ShapeModel& m, const PairOptions& o, std::uint64_t seed)
+{
   bullet::Shapes shapes;
   bullet::DropBody body;
   if (m.kind == ShapeKind::mesh) {
@@ -483,18 +517,17 @@ PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap
   }
   bullet::DropWorld w(body, states, s);
   const long steps = static_cast<long>(std::ceil(o.pile_time / o.pile_dt));
-  PileOutcome out;
+  ReferencePile out;
   out.bodies = static_cast<int>(w.size());
   for (long k = 0; k < steps; ++k) {
     w.step(o.pile_dt);
+    ++out.steps;
     if (k % 24 == 0 && w.asleep_count() == w.size()) {
       out.asleep = true;
       break;
     }
   }
   out.asleep = out.asleep || w.asleep_count() == w.size();
-  const std::vector<Eigen::Vector3d> faces = faces_by_area(m);
-  const std::vector<double> offsets = face_offsets(m, faces);
   std::map<std::pair<std::size_t, std::size_t>, std::vector<bullet::DropWorld::BodyContact>> by_pair;
   for (const auto& c : w.body_contacts(o.touch_distance)) by_pair[{c.a, c.b}].push_back(c);
   for (const auto& [key, points] : by_pair) {
@@ -505,31 +538,53 @@ PileOutcome run_pile(const ShapeModel& m, const PairOptions& o, const SupportMap
       n += c.normal;
       deepest = std::max(deepest, -c.distance);
     }
+    PileContact p;
+    p.a.position = a.position;
+    p.a.orientation = a.orientation;
+    p.b.position = b.position;
+    p.b.orientation = b.orientation;
     // Points of a nested pair can point opposite ways: then the first stands.
-    n = n.norm() > 0.5 ? Eigen::Vector3d(n.normalized()) : points.front().normal;
-    const Eigen::Vector3d ab = b.position - a.position;
-    const Eigen::Vector3d e = ab.normalized();
-    const Eigen::Matrix3d ra = a.orientation.toRotationMatrix(), rb = b.orientation.toRotationMatrix();
-    PilePair p;
-    p.distance = ab.norm();
-    p.angle_deg = std::acos(std::min(1.0, std::fabs(e.z()))) * 180.0 / kPi;
-    p.along_normal = ab.dot(n);
-    p.support_e = support(m.hull, ra.transpose() * e) + support(m.hull, -(rb.transpose() * e));
-    p.support_e_map = map.lookup(ra.transpose() * e) + map.lookup(-(rb.transpose() * e));
-    p.support_n = support(m.hull, ra.transpose() * n) + support(m.hull, -(rb.transpose() * n));
+    p.normal = n.norm() > 0.5 ? Eigen::Vector3d(n.normalized()) : points.front().normal;
     p.penetration = deepest;
-    const auto exact = [&](const Eigen::Vector3d& u) { return support(m.hull, u); };
-    const auto table = [&](const Eigen::Vector3d& u) { return map.lookup(u); };
-    p.radial6 = radial_estimate(exact, ra, rb, e, faces, 6);
-    p.radial16 = radial_estimate(exact, ra, rb, e, faces, 16);
-    p.radial_all = radial_estimate(exact, ra, rb, e, faces, faces.size());
-    p.radial_map = radial_estimate(table, ra, rb, e, faces, static_cast<std::size_t>(o.candidate_faces), &offsets);
-    out.pairs.push_back(p);
+    out.contacts.push_back(p);
   }
   return out;
 }
 
-}  // namespace
+PairDistances pair_distances(const ShapeModel& m, const std::vector<double>& spin_ratios, int trials, double speed,
+                             double margin, std::uint64_t seed, unsigned threads, bool show_progress)
+{
+  PairDistances r;
+  const std::size_t ns = spin_ratios.size(), nt = static_cast<std::size_t>(trials);
+  constexpr std::size_t chunk = 20;
+  const std::size_t chunks = (nt + chunk - 1) / chunk;
+  std::vector<double> dist(ns * nt), hull(ns * nt);
+  Progress progress("pair flights", ns * nt, show_progress);
+  parallel_for(
+      ns * chunks,
+      [&](std::size_t task) {
+        const std::size_t si = task / chunks, c = task % chunks;
+        PairGeometry g(m, margin);
+        std::unique_ptr<TouchQuery> touch;
+        if (!g.convex) touch = std::make_unique<TouchQuery>(g.full);
+        for (std::size_t t = c * chunk; t < std::min(nt, (c + 1) * chunk); ++t) {
+          const PairStart st = pair_start(m, spin_ratios[si], speed, seed, si * nt + t);
+          dist[si * nt + t] = pair_flight(m, g, touch.get(), st, false, &hull[si * nt + t]);
+        }
+        progress.add(std::min(nt, (c + 1) * chunk) - c * chunk);
+      },
+      threads);
+  progress.finish();
+  for (std::size_t si = 0; si < ns; ++si) {
+    const Summary s = summarise(std::vector<double>(dist.begin() + si * nt, dist.begin() + (si + 1) * nt));
+    const Summary sh = summarise(std::vector<double>(hull.begin() + si * nt, hull.begin() + (si + 1) * nt));
+    r.mean.push_back(s.mean);
+    r.std.push_back(s.std);
+    r.hull_mean.push_back(sh.mean);
+  }
+  r.flights = static_cast<long long>(ns * nt);
+  return r;
+}
 
 PairResult gather_pairs(const PairOptions& options)
 {
@@ -557,34 +612,12 @@ PairResult gather_pairs(const PairOptions& options)
   // Pair distance per spin ratio.
   const auto t0 = std::chrono::steady_clock::now();
   {
-    const std::size_t ns = o.spin_ratios.size(), nt = static_cast<std::size_t>(o.trials);
-    constexpr std::size_t chunk = 20;
-    const std::size_t chunks = (nt + chunk - 1) / chunk;
-    std::vector<double> dist(ns * nt), hull(ns * nt);
-    Progress progress("pair flights", ns * nt, o.shape.progress);
-    parallel_for(
-        ns * chunks,
-        [&](std::size_t task) {
-          const std::size_t si = task / chunks, c = task % chunks;
-          PairGeometry g(m, o.shape.reference.margin);
-          std::unique_ptr<TouchQuery> touch;
-          if (!g.convex) touch = std::make_unique<TouchQuery>(g.full);
-          for (std::size_t t = c * chunk; t < std::min(nt, (c + 1) * chunk); ++t) {
-            const PairStart st = pair_start(m, o.spin_ratios[si], o.speed, o.shape.seed, si * nt + t);
-            dist[si * nt + t] = pair_flight(m, g, touch.get(), st, false, &hull[si * nt + t]);
-          }
-          progress.add(std::min(nt, (c + 1) * chunk) - c * chunk);
-        },
-        threads);
-    progress.finish();
-    for (std::size_t si = 0; si < ns; ++si) {
-      const Summary s = summarise(std::vector<double>(dist.begin() + si * nt, dist.begin() + (si + 1) * nt));
-      const Summary sh = summarise(std::vector<double>(hull.begin() + si * nt, hull.begin() + (si + 1) * nt));
-      r.pair_mean.push_back(s.mean);
-      r.pair_std.push_back(s.std);
-      r.pair_hull_mean.push_back(sh.mean);
-    }
-    r.pair_flights = static_cast<long long>(ns * nt);
+    const PairDistances d = pair_distances(m, o.spin_ratios, o.trials, o.speed, o.shape.reference.margin,
+                                           o.shape.seed, threads, o.shape.progress);
+    r.pair_mean = d.mean;
+    r.pair_std = d.std;
+    r.pair_hull_mean = d.hull_mean;
+    r.pair_flights = d.flights;
   }
   r.pair_seconds = seconds_since(t0);
 

@@ -158,6 +158,34 @@ double pair_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed
                   bool hull_only, double margin, double* hull_distance = nullptr,
                   std::pair<RigidState, RigidState>* at_contact = nullptr);
 
+/// Pair distance at first contact (1.) per spin ratio: mean, sample standard deviation and the
+/// hulls' mean, m; `trials` flights per ratio at relative speed `speed` (m/s), the true geometry
+/// with `margin` (m). Deterministic for a seed, any thread count.
+struct PairDistances {
+  std::vector<double> mean, std, hull_mean;
+  long long flights = 0;
+};
+PairDistances pair_distances(const ShapeModel& model, const std::vector<double>& spin_ratios, int trials, double speed,
+                             double margin, std::uint64_t seed, unsigned threads, bool progress);
+
+/// A touching pair of a reference pile: both bodies' poses (position and orientation are set),
+/// the mean contact normal from a to b and the deepest manifold point's penetration (m, >= 0).
+struct PileContact {
+  RigidState a, b;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double penetration = 0.0;
+};
+/// One reference pile of 3. (a drop pile, or a bin when `options.bin` > 0) run until every body
+/// sleeps or `pile_time` passes: its touching pairs (a before b, by body index), body count,
+/// whether all slept and the Bullet steps taken.
+struct ReferencePile {
+  std::vector<PileContact> contacts;
+  int bodies = 0;
+  bool asleep = false;
+  long steps = 0;
+};
+ReferencePile reference_pile(const ShapeModel& model, const PairOptions& options, std::uint64_t seed);
+
 /// Runs everything the options ask for (deterministic for a seed, any thread count).
 PairResult gather_pairs(const PairOptions& options);
 

@@ -52,6 +52,7 @@ struct GatherCommand {
   bool speed_check = false;
   bool step_check = false;
   bool settings_check = false;
+  bool no_body_contacts = false;
   std::vector<double> check_speeds = {0.5, 1, 2, 4, 8};
   int check_trials = 200;
   // --size-for-scene (tools/ref3d/sizing.hpp)
@@ -168,6 +169,7 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.i16 = c.precision == "i16";
     o.response_model = parse_response_model(c.response_model);
     o.reference.mesh_hull = c.mesh_shape == "hull";
+    o.body_contacts = !c.no_body_contacts;
     validate_gather_options(o);
     if (c.speed_check || c.step_check || c.settings_check) {
       std::string report;
@@ -337,6 +339,18 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
       ->check(CLI::IsMember({"gimpact", "hull"}))
       ->capture_default_str();
   sub->add_option("--density", o.density, "Density, kg/m^3 (sets the recorded mass only)")->capture_default_str();
+  sub->add_flag("--no-body-contacts", c->no_body_contacts,
+                "Leave out the body-body data (a table of format 2.0, as written before it existed)");
+  sub->add_option("--support-size", o.support_size, "Body-body: support map nodes a side, S (6 S^2 values)")
+      ->capture_default_str();
+  sub->add_option("--contact-faces", o.contact_faces, "Body-body: largest hull faces stored (fewer if the hull has fewer)")
+      ->capture_default_str();
+  sub->add_option("--pair-trials", o.pair_trials, "Body-body: pair flights per h_coll spin ratio")->capture_default_str();
+  sub->add_option("--packing-piles", o.packing_piles, "Body-body: Bullet drop piles for the packing ratios")
+      ->capture_default_str();
+  sub->add_option("--packing-bins", o.packing_bins, "Body-body: Bullet bins of stacked bodies for the packing ratios")
+      ->capture_default_str();
+  sub->add_option("--packing-count", o.packing_count, "Body-body: bodies per pile and per bin")->capture_default_str();
   sub->add_flag("--quiet", c->quiet, "No progress on stderr");
   sub->add_flag("--size-for-scene", c->size_for_scene,
                 "Size the table for a scene (tools/ref3d/sizing.hpp): gather densely over the scene's range (the axes "

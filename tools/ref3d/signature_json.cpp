@@ -86,6 +86,18 @@ void set_responses(BasicLoadedSignature3<LoadedQuantized16>& s, std::vector<Scal
   s.response_spread = quantized(spread, std_scale, std_offset, "spread");
 }
 
+// The support map as the table stores it: floats, or 16 bits by statsim::quantize16.
+void set_support(BasicLoadedSignature3<std::vector<Scalar>>& s, std::vector<Scalar> values)
+{
+  s.contact.support = std::move(values);
+}
+void set_support(BasicLoadedSignature3<LoadedQuantized16>& s, const std::vector<Scalar>& values)
+{
+  LoadedQuantized16& q = s.contact.support;
+  q.q.resize(values.size());
+  quantize16(values.data(), values.size(), q.scale, q.offset, q.q.data());
+}
+
 // Every part of `s` from the JSON `j`, checked in the order of the format.
 template <class Responses>
 void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::string& origin)
@@ -158,6 +170,30 @@ void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::
     s.rest_heights.push_back(number(p, "height", origin, "rest[]."));
     s.rest_frequencies.push_back(number(p, "frequency", origin, "rest[]."));
   }
+  if (!j.contains("body_contacts")) return;
+  s.mesh_frame = numbers(j, "mesh_frame", origin);
+  expect_size(s.mesh_frame, 12, "mesh_frame", origin);
+  const json& c = field(j, "body_contacts", origin);
+  const Scalar size = number(c, "support_size", origin, "body_contacts.");
+  if (!(size >= 2 && size <= Scalar(max_support_size)) || size != std::floor(size))
+    fail(origin, "field 'body_contacts.support_size' must be a whole number in [2, " +
+                     std::to_string(max_support_size) + "]");
+  s.contact.support_size = static_cast<std::uint32_t>(size);
+  std::vector<Scalar> support = numbers(c, "support", origin, "body_contacts.");
+  expect_size(support, support_values(3, s.contact.support_size), "body_contacts.support", origin);
+  set_support(s, std::move(support));
+  s.contact.pair_mean = numbers(c, "pair_mean", origin, "body_contacts.");
+  s.contact.pair_stddev = numbers(c, "pair_stddev", origin, "body_contacts.");
+  expect_size(s.contact.pair_mean, s.height_axis.size(), "body_contacts.pair_mean", origin);
+  expect_size(s.contact.pair_stddev, s.height_axis.size(), "body_contacts.pair_stddev", origin);
+  s.contact.faces = numbers(c, "faces", origin, "body_contacts.");
+  if (s.contact.faces.size() % 4 != 0) fail(origin, "field 'body_contacts.faces' must hold 4 numbers a face");
+  const std::vector<Scalar> pm = numbers(c, "packing_mean", origin, "body_contacts.");
+  const std::vector<Scalar> ps = numbers(c, "packing_stddev", origin, "body_contacts.");
+  expect_size(pm, 3, "body_contacts.packing_mean", origin);
+  expect_size(ps, 3, "body_contacts.packing_stddev", origin);
+  std::copy(pm.begin(), pm.end(), s.contact.packing_mean.begin());
+  std::copy(ps.begin(), ps.end(), s.contact.packing_stddev.begin());
 }
 
 }  // namespace

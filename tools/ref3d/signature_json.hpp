@@ -10,7 +10,9 @@
 // format 1 (no "model"; "std" and std_scale / std_offset) load as the paper's model. When the JSON has "i16", the
 // response tables are quantised again by the generator's rule, statsim::quantize16 (which must
 // give the scales and offsets the JSON states), and used as 16-bit integers, as the generated
-// SignatureQ16 header stores them.
+// SignatureQ16 header stores them. Tables of format 2.1 also give mesh_frame and body_contacts
+// {support_size, support, pair_mean, pair_stddev, faces, packing_mean, packing_stddev}; the
+// support map of an i16 table is quantised by statsim::quantize16 as the header stores it.
 #pragma once
 
 #include "statsim/signature.hpp"
@@ -51,6 +53,17 @@ struct BasicLoadedSignature3 {
   std::vector<Scalar> axis0, axis1, axis2, axis3;
   Responses response_mean, response_spread;
   std::vector<Scalar> rest_normals, rest_heights, rest_frequencies;
+  /// Mesh frame (12 numbers); empty in a table without body-body data (the identity).
+  std::vector<Scalar> mesh_frame;
+  /// Body-body data (statsim::ContactView); support_size 0 when the JSON has none. The support
+  /// map is stored as the response tables are (i16 tables: by statsim::quantize16).
+  struct Contact {
+    std::uint32_t support_size = 0;
+    std::vector<Scalar> pair_mean, pair_stddev;
+    Responses support;
+    std::vector<Scalar> faces;
+    std::array<Scalar, 3> packing_mean{}, packing_stddev{};
+  } contact;
 
   SignatureView<3> view() const { return signature_view<3>(*this); }
 };

@@ -391,6 +391,11 @@ GatherResult sized_result(const GatherResult& dense, const SizingResult& s, cons
   o.height_ratios = pick(dense.options.height_ratios, hk);
   r.height_mean = pick(dense.height_mean, hk);
   r.height_std = pick(dense.height_std, hk);
+  if (dense.contact.pair_mean.size() == dense.options.height_ratios.size()) {
+    // The pair distance lies on the h_coll axis: the same samples.
+    r.contact.pair_mean = pick(dense.contact.pair_mean, hk);
+    r.contact.pair_std = pick(dense.contact.pair_std, hk);
+  }
   for (std::size_t a = 0; a < r.axes.size(); ++a) r.axes[a] = pick(dense.axes[a], c.keep[a]);
   o.cos_theta = r.axes[0];
   o.cos_phi = r.axes[1];
