@@ -39,11 +39,6 @@ constexpr Scalar no_bounce = std::numeric_limits<Scalar>::infinity();
 /// Passes after the impact pass count spheres within this fraction of their radius as touching:
 /// the impact pass leaves resting contacts exactly touching, not overlapping.
 constexpr Scalar contact_slop = Scalar(1e-3);
-/// A hull contact whose normal is within 60 degrees of up carries the upper body
-/// (`Body::supported`): it takes a rest pose there and turns into it. Steeper than the ground's
-/// `ground_cosine`, because a body lying tilted on another's edge or corner is what the turn
-/// must set down flat, as it would topple in the reference.
-constexpr Scalar carry_cosine = Scalar(0.5);
 
 /// The response of one body alone against a plane with normal `n` (towards the body), with
 /// its velocity taken relative to `other_velocity`: the statistical response for statistical
@@ -53,8 +48,7 @@ constexpr Scalar carry_cosine = Scalar(0.5);
 /// `tilted_plane`: the contact is with a plane that gravity pulls the body along.
 template <int D>
 void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const typename Space<D>::Vec& n,
-                   const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false,
-                   bool turn_up = false)
+                   const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& shape = w.shapes[b.shape];
@@ -103,13 +97,9 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
     particle_plane_response<D>(v, b.angular_velocity, contact_radius(w, b), n, shape.material,
                                def.restitution_threshold);
   } else if (ground_contact && b.rest_pose != no_rest_pose) {
-    // On another body the pair falls together, so a resting contact there need not approach:
-    // it turns all the same.
-    const bool approaching = v.dot(n) < 0;
-    if (!approaching && !turn_up) return;
-    if (approaching) v = point_particle_velocity<D>(v, n, shape.material, def.restitution_threshold);
-    const Vec toward = turn_up ? Vec(Vec::Unit(Space<D>::up_axis)) : n;
-    b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), toward, def.rest_turn_time);
+    if (!(v.dot(n) < 0)) return;
+    v = point_particle_velocity<D>(v, n, shape.material, def.restitution_threshold);
+    b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, def.rest_turn_time);
     // A small turn (paper 3.4): its farthest point moves at most at the settle speed, so a
     // slow body is not spun up (sin(angle) / rest_turn_time alone reaches 10 rad/s).
     const Scalar cap = def.settle_speed / b.bounding_radius;
@@ -138,12 +128,8 @@ void respond_pair(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D>& 
 {
   using Vec = typename Space<D>::Vec;
   const Vec va = a.linear_velocity, vb = b.linear_velocity;
-  // With hull contacts a body resting on another near-level one turns into its rest pose there,
-  // as on the ground (paper 3.4).
-  const bool hulls = hull_pair(w, a, b);
-  const Scalar up = n[Space<D>::up_axis];
-  if (ima > 0) respond_alone(w, ctx, a, -n, vb, hulls && -up >= carry_cosine, false, true);
-  if (imb > 0) respond_alone(w, ctx, b, n, va, hulls && up >= carry_cosine, false, true);
+  if (ima > 0) respond_alone(w, ctx, a, -n, vb, false);
+  if (imb > 0) respond_alone(w, ctx, b, n, va, false);
   if (w.def.pair_response != PairResponse::momentum) return;
   // Change of (vb - va) as each body saw it; a static side saw none, so the other counts alone.
   const Vec from_b = (b.linear_velocity - va) - (vb - va);
@@ -166,17 +152,8 @@ bool particle_pair(const WorldData<D>& w, Body<D>& a, Body<D>& b, const typename
                                         : mix(w.shapes[a.shape].material, w.shapes[b.shape].material);
   const ContactSide<D> sa{a.linear_velocity, a.angular_velocity, ima, ra};
   const ContactSide<D> sb{b.linear_velocity, b.angular_velocity, imb, rb};
-  if (!hull_pair(w, a, b))
-    return ra == 0 && rb == 0 ? particle_point_response<D>(sa, sb, n, m, threshold)
-                              : particle_response<D>(sa, sb, n, m, threshold);
-  // A body turning into its rest pose on another spins because the resting conditions make it
-  // (`respond_alone`): rolling resistance, which stops a body's roll, would stop the turn.
-  const typename Space<D>::Spin wa = a.angular_velocity, wb = b.angular_velocity;
-  const bool applied = ra == 0 && rb == 0 ? particle_point_response<D>(sa, sb, n, m, threshold)
-                                          : particle_response<D>(sa, sb, n, m, threshold);
-  if (a.rest_pose != no_rest_pose && a.supported) a.angular_velocity = wa;
-  if (b.rest_pose != no_rest_pose && b.supported) b.angular_velocity = wb;
-  return applied;
+  return ra == 0 && rb == 0 ? particle_point_response<D>(sa, sb, n, m, threshold)
+                            : particle_response<D>(sa, sb, n, m, threshold);
 }
 
 /// Inverse masses of a touching pair: 0 for a sleeper. In the bottom-up passes (shock and
@@ -357,11 +334,6 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
     if (!resolve(a, b, c, slop, reach)) continue;
     a.touching = true;
     b.touching = true;
-    if (!hull_pair(w, a, b)) continue;
-    // A hull contact near the vertical carries the upper body as the ground would.
-    const Scalar up = c.normal[Space<D>::up_axis];
-    if (up >= carry_cosine) b.supported = true;
-    else if (-up >= carry_cosine) a.supported = true;
   }
   return touching;
 }
@@ -373,7 +345,6 @@ void forget_contacts(WorldData<D>& w)
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     w.bodies[i].touching = false;
     w.bodies[i].on_ground = false;
-    w.bodies[i].supported = false;
   }
 }
 

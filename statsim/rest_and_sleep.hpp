@@ -129,11 +129,8 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const Scalar w2 = turning ? Scalar(0) : squared_norm(b.angular_velocity) * r2;
     const Scalar speed2 = v2 > w2 ? v2 : w2;
     const bool settling = b.touching && speed2 < settle2;
-    // A body carried by another (`Body::supported`) takes its pose against up: piles stand on
-    // near-level ground.
-    const bool carried = b.on_ground || b.supported;
     const Vec ground = settling && b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
-    update_rest_pose(w, b, settling && carried, settling && !carried, speed2 >= settle2, dt, ground);
+    update_rest_pose(w, b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt, ground);
     if (!settling) {
       b.state = MotionState::moving;
       b.slow_time = 0;
@@ -146,15 +143,19 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     // never moves and never sleeps (tools/ref2d/README.md shows how often in a pile).
     const Scalar moved2 = (b.position - b.step_start).squaredNorm();
     const Scalar lin2 = moved2 < v2 * dt * dt ? moved2 / (dt * dt) : v2;
-    // It turns at ground contacts and, with hull contacts, on bodies that carry it: one that
-    // keeps its pose while held up otherwise cannot reach it there, and may sleep where it is.
-    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (!turning || !carried || in_rest_pose(w, b, ground));
+    // It turns at ground contacts: one that keeps its pose while held up by other bodies cannot
+    // reach it there, and may sleep where it is.
+    const bool posed = !turning || !b.on_ground || in_rest_pose(w, b, ground);
+    // On its hull (`hull_radius`) a body propped by others may stay still out of its pose; it
+    // sleeps where it is after three sleep times.
+    const bool wedged = !posed && hull_radius(w, b, ground) > b.radius;
+    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (posed || wedged);
     b.slow_time = still ? b.slow_time + dt : 0;
-    if (still && b.slow_time >= def.sleep_time) {
+    if (still && b.slow_time >= (posed ? def.sleep_time : 3 * def.sleep_time)) {
       b.state = MotionState::asleep;
       b.linear_velocity = Vec::Zero();
       b.angular_velocity = Space<D>::zero_spin();
-      if (b.rest_pose != no_rest_pose && b.on_ground) {
+      if (b.rest_pose != no_rest_pose && b.on_ground && posed) {
         // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
         // the radius blend are below what a slow body would show.
         // The centre stood `hull_radius` above the ground (the collision radius, or the hull's

@@ -158,7 +158,6 @@ class WorldCore {
     b.state = def.asleep ? MotionState::asleep : MotionState::moving;
     b.touching = false;
     b.on_ground = false;
-    b.supported = false;
     b.rest_pose = no_rest_pose;
     b.pile_rest = false;
     b.rest_blend = 0;

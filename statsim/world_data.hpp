@@ -101,9 +101,8 @@ void hash_def(Fnv1a& h, const WorldDef<D>& d)
             std::uint8_t(d.pair_response), std::uint8_t(d.rest_conditions), std::uint8_t(d.pile_rest),
             d.rest_blend_time, d.rest_turn_time, d.rest_snap_cosine, d.ground_cosine, std::uint8_t(d.broad_phase),
             d.grid_above_bodies, std::int32_t(d.sweep_axis), std::uint8_t(d.table_restitution_threshold));
-  // Added only when not the default, so that worlds whose tables have no body-body data (which
-  // step as before the option) keep their hashes.
-  if (d.body_contacts != BodyContacts::hulls) h.add(std::uint8_t(d.body_contacts));
+  // Added only when not the default, so that worlds from before the option keep their hashes.
+  if (d.body_contacts != BodyContacts::collision_spheres) h.add(std::uint8_t(d.body_contacts));
 }
 
 /// Adds a table's numbers as the runtime reads them (16-bit ones as their values).
@@ -170,7 +169,7 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add_vec(b.linear_velocity);
     h.add_spin(b.angular_velocity);
     h.add_all(b.radius, b.bounding_radius, b.inv_mass, b.slow_time, b.rng_state, b.rest_blend, b.shape,
-              std::uint8_t(b.state), std::uint8_t(b.touching), std::uint8_t(b.on_ground | (b.supported << 1)), b.rest_pose,
+              std::uint8_t(b.state), std::uint8_t(b.touching), std::uint8_t(b.on_ground), b.rest_pose,
               std::uint8_t(b.pile_rest));
   }
   for (std::uint32_t i = 0; i < w.plane_count; ++i) {

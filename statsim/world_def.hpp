@@ -162,9 +162,11 @@ struct WorldDef {
   /// samples made to conserve momentum (the default: in piles the independent responses add
   /// energy, see statsim/README.md, "Statistical bodies").
   PairResponse pair_response = PairResponse::momentum;
-  /// Where bodies touch each other: at their hulls (default; the paper's spheres for tables
-  /// without body-body data), or always at their collision spheres.
-  BodyContacts body_contacts = BodyContacts::hulls;
+  /// Where bodies touch each other: at their collision spheres (default, the paper's rule), or at
+  /// their hulls for tables with body-body data. Hulls hold stacks at their true height and keep
+  /// bodies out of the ground; they are not the default yet because a few bodies of a large
+  /// L-shape pile then stay awake (statsim/README.md, "Statistical bodies").
+  BodyContacts body_contacts = BodyContacts::collision_spheres;
   /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
   bool rest_conditions = true;
   /// Bodies settling on other bodies (not on the ground) blend their radius to the shape's
@@ -216,9 +218,6 @@ struct Body {
   MotionState state;
   bool touching;                          ///< touched a plane or body in the last step
   bool on_ground;                         ///< touched a near-horizontal plane in the last step
-  /// Rested on another body in the last step, along a hull contact whose normal is within 60
-  /// degrees of up (`BodyContacts::hulls`): it settles into a rest pose there as on the ground.
-  bool supported;
   std::uint8_t rest_pose;                 ///< chosen rest pose, or `no_rest_pose`
   bool pile_rest;                         ///< settling on other bodies, blending to the mean h_rest (`WorldDef::pile_rest`)
 };

@@ -15,7 +15,7 @@
 // Body-body: support map S = 17 (1734 values, i16; at most 0.00681 m above the hull's support), 7 of the hull's 7 faces, mesh frame from the principal axes and centre of mass
 // Body-body: pair distance: 3200 pair flights (400 per h_coll spin ratio, head-on at 2 m/s relative speed)
 // Body-body: packing: 10 drop piles and 6 bins (walls 4.4 L apart) of 50 bodies in Bullet, seeds 1.., until all sleep (at most 20 s at 1/240 s; 16 of 16 all asleep; 15160 Bullet steps in all); 1042 touching pairs
-// Body-body: packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1): 0-30 deg 0.8234 +- 0.2250 (78 pairs); 30-60 deg 0.8433 +- 0.2006 (291 pairs); 60-90 deg 0.8735 +- 0.1638 (673 pairs)
+// Body-body: packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1): along faces 0.8942 (280), 0.8857 (318), 0.9428 (131), 0.6971 (157), 0.9147 (67), 0.9311 (21), 0.8265 (16); along the line of centres 0-30 deg 0.7392 +- 0.1842 (5 pairs, pooled); 30-60 deg 0.7496 +- 0.1607 (15 pairs); 60-90 deg 0.7669 +- 0.1583 (32 pairs)
 // Body-body: support map i16 dequantization error 1.28e-06 m
 #pragma once
 
@@ -545,19 +545,19 @@ inline constexpr SignatureQ16<3, 8, 4, 5, 8, 1, 5, 6, ContactDataQ16<3, 8, 17, 7
         27306, 15291, 15837, 16384, 16930, 17476, 18022, 18568, 19114, 19660, 20206, 20752,
         21299, 21845, 24575, 27306, 30036, 32767
       }}},  // scale, offset, values
-      // hull faces, largest first: outward unit normal (body frame), offset (m)
+      // hull faces, largest first: outward unit normal (body frame), offset (m), packing ratio along it
       {{
-        0x0p+0f, 0x0p+0f, 0x1p+0f, 0x1.99999ap-6f,
-        0x0p+0f, 0x0p+0f, -0x1p+0f, 0x1.99999ap-6f,
-        0x1.c9f25cp-2f, -0x1.c9f25cp-1f, 0x0p+0f, 0x1.99999ap-5f,
-        0x1.fc0bd8p-4f, 0x1.fc0bd8p-1f, 0x0p+0f, 0x1.1c01aap-4f,
-        -0x1.c9f25cp-1f, -0x1.c9f25cp-2f, 0x0p+0f, 0x1.333334p-4f,
-        0x1.c9f25cp-1f, 0x1.c9f25cp-2f, 0x0p+0f, 0x1p-3f,
-        -0x1.c9f25cp-2f, 0x1.c9f25cp-1f, 0x0p+0f, 0x1.99999ap-4f
+        0x0p+0f, 0x0p+0f, 0x1p+0f, 0x1.99999ap-6f, 0x1.c9d9bp-1f,
+        0x0p+0f, 0x0p+0f, -0x1p+0f, 0x1.99999ap-6f, 0x1.c57daap-1f,
+        0x1.c9f25cp-2f, -0x1.c9f25cp-1f, 0x0p+0f, 0x1.99999ap-5f, 0x1.e2b892p-1f,
+        0x1.fc0bd8p-4f, 0x1.fc0bd8p-1f, 0x0p+0f, 0x1.1c01aap-4f, 0x1.64ec2cp-1f,
+        -0x1.c9f25cp-1f, -0x1.c9f25cp-2f, 0x0p+0f, 0x1.333334p-4f, 0x1.d45208p-1f,
+        0x1.c9f25cp-1f, 0x1.c9f25cp-2f, 0x0p+0f, 0x1p-3f, 0x1.dcb2c2p-1f,
+        -0x1.c9f25cp-2f, 0x1.c9f25cp-1f, 0x0p+0f, 0x1.99999ap-4f, 0x1.a726cap-1f
       }},
-      // packing (d / hull distance along the line of centres): mean, std at 0-30, 30-60, 60-90 deg
-      {{0x1.a599f2p-1f, 0x1.afc44ap-1f, 0x1.bf3d78p-1f}},
-      {{0x1.ccbff2p-3f, 0x1.9acc52p-3f, 0x1.4f7ce6p-3f}},
+      // packing along the line of centres (d / hull distance): mean, std at 0-30, 30-60, 60-90 deg
+      {{0x1.7a7df6p-1f, 0x1.7fcac8p-1f, 0x1.88a4bap-1f}},
+      {{0x1.79305ep-3f, 0x1.492c9cp-3f, 0x1.442966p-3f}},
     },
 };
 

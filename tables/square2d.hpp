@@ -24,7 +24,7 @@
 // body-body data: support map S = 9 (36 values; at most 0.00276 m above the hull's support), 4 of the hull's 4 edges, mesh frame: the input's frame at the centroid
 //   pair distance: 32000 pair flights (2000 per height-table spin ratio, head-on at 2 m/s relative speed, exact outlines)
 //   packing: 10 Box2D piles of 100 bodies (statsim compare2d's, seeds 1..), 900 steps of 1/60 s; 10 of 10 all asleep; 1287 touching pairs
-//   packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1): 0-30 deg 1.0151 +- 0.0017 (415 pairs); 30-60 deg 1.0152 +- 0.0017 (605 pairs); 60-90 deg 1.0157 +- 0.0018 (267 pairs)
+//   packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1): along faces 1.0154 (312), 1.0152 (336), 1.0151 (302), 1.0151 (334); along the line of centres 0-30 deg 1.0152 +- 0.0017 (0 pairs, pooled); 30-60 deg 1.0152 +- 0.0017 (0 pairs, pooled); 60-90 deg 1.0152 +- 0.0017 (3 pairs, pooled)
 #pragma once
 
 #include "statsim/signature.hpp"
@@ -447,16 +447,16 @@ inline constexpr Signature<2, 16, 7, 9, 5, 1, 4, 3, ContactData<2, 16, 9, 4>> sq
         0x1.8p-1f, 0x1.cp-1f, 0x1p+0f, 0x1p+0f, 0x1.cp-1f, 0x1.8p-1f,
         0x1.4p-1f, 0x1p-1f, 0x1.4p-1f, 0x1.8p-1f, 0x1.cp-1f, 0x1p+0f
       }},
-      // hull edges, largest first: outward unit normal (body frame), offset (m)
+      // hull edges, largest first: outward unit normal (body frame), offset (m), packing ratio along it
       {{
-        0x0p+0f, -0x1p+0f, 0x1p-1f,
-        0x1p+0f, 0x0p+0f, 0x1p-1f,
-        0x0p+0f, 0x1p+0f, 0x1p-1f,
-        -0x1p+0f, 0x0p+0f, 0x1p-1f
+        0x0p+0f, -0x1p+0f, 0x1p-1f, 0x1.03f482p+0f,
+        0x1p+0f, 0x0p+0f, 0x1p-1f, 0x1.03e6c6p+0f,
+        0x0p+0f, 0x1p+0f, 0x1p-1f, 0x1.03e028p+0f,
+        -0x1p+0f, 0x0p+0f, 0x1p-1f, 0x1.03de44p+0f
       }},
-      // packing (d / hull distance along the line of centres): mean, std at 0-30, 30-60, 60-90 deg
-      {{0x1.03dc52p+0f, 0x1.03e10ep+0f, 0x1.040246p+0f}},
-      {{0x1.bf3202p-10f, 0x1.b5a41ep-10f, 0x1.d99b22p-10f}},
+      // packing along the line of centres (d / hull distance): mean, std at 0-30, 30-60, 60-90 deg
+      {{0x1.03e66ap+0f, 0x1.03e66ap+0f, 0x1.03e66ap+0f}},
+      {{0x1.c3b8cp-10f, 0x1.c3b8cp-10f, 0x1.c3b8cp-10f}},
     },
 };
 

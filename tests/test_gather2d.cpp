@@ -475,15 +475,15 @@ TEST_CASE("gather2d: a gathered square's body-body data is the closed form of a 
             doctest::Approx(0.5 * (1 + std::fabs(-1.0 + 2.0 * i / (S - 1)))).epsilon(1e-9));
   // Its four edges, each axis direction once, 0.5 m from the centre.
   REQUIRE(c.hull_faces == 4);
-  REQUIRE(c.faces.size() == 4u * 3u);
+  REQUIRE(c.faces.size() == 4u * 4u);
   std::vector<int> seen(4, 0);
   for (std::size_t k = 0; k < 4; ++k) {
-    const double x = c.faces[3 * k], y = c.faces[3 * k + 1];
+    const double x = c.faces[4 * k], y = c.faces[4 * k + 1];
     CHECK(std::hypot(x, y) == doctest::Approx(1.0));
     const int axis = std::fabs(y) > std::fabs(x) ? 1 : 0;
     CHECK(std::fabs(axis ? y : x) == doctest::Approx(1.0));
     ++seen[static_cast<std::size_t>(2 * axis + ((axis ? y : x) < 0 ? 1 : 0))];
-    CHECK(c.faces[3 * k + 2] == doctest::Approx(0.5));
+    CHECK(c.faces[4 * k + 2] == doctest::Approx(0.5));
   }
   CHECK(seen == std::vector<int>(4, 1));
   REQUIRE(c.mesh_frame.size() == 6);

@@ -98,6 +98,9 @@ public:
     WorldDef<D> def;
     def.seed = seed;
     def.rest_conditions = variant.rest_conditions;
+    // The benchmark and the fidelity scenes measure the hull contacts of tables that have
+    // body-body data (tools/fidelity/README.md, "With hull contacts").
+    def.body_contacts = BodyContacts::hulls;
     if (variant.independent_pairs) def.pair_response = PairResponse::independent;
     set_broad_phase(def.broad_phase, broad_phase);
     world_ = std::make_unique<WorldT>(def);

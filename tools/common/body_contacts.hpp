@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,16 +20,20 @@ struct BodyContactData {
   int support_size = 0;
   std::vector<double> support;  ///< m, 6 S^2 values (2D: 4 S), layout of statsim::ContactView
   double support_bound = 0.0;   ///< m: the map never reads more than this above the hull's support
-  std::vector<double> faces;    ///< per face: outward unit normal, offset (m); largest first
+  /// Per face, largest first: outward unit normal, offset (m), packing ratio of the pairs whose
+  /// hull contact is along it (statsim::face_values(D) numbers a face).
+  std::vector<double> faces;
+  std::vector<int> face_pairs;      ///< touching pairs per face
+  std::vector<char> face_pooled;    ///< the face had too few pairs and took the pooled ratio
   int hull_faces = 0;           ///< faces (2D: edges) of the whole hull
   std::array<double, 3> packing_mean{{1, 1, 1}}, packing_std{{0, 0, 0}};
-  std::array<int, 3> packing_pairs{};      ///< touching pairs per angle bin
+  std::array<int, 3> packing_pairs{};      ///< pairs touching along their line of centres, per angle bin
   std::array<bool, 3> packing_pooled{};    ///< the bin had too few pairs and took all pairs' statistics
   int total_pairs = 0;
   int piles = 0, bins = 0, asleep = 0;  ///< piles and bins run, and how many ended all asleep
   long long pile_steps = 0;             ///< reference steps over all piles and bins
   double pair_seconds = 0.0, packing_seconds = 0.0;
-  std::size_t face_count() const { return faces.size() / static_cast<std::size_t>(dims + 1); }
+  std::size_t face_count() const { return faces.size() / static_cast<std::size_t>(dims + 2); }
 };
 
 /// An angle bin with fewer touching pairs than this takes the statistics of all pairs.
@@ -38,10 +43,22 @@ constexpr int kPackingMinPairs = 10;
 /// component is `up` over its length `length`.
 int packing_bin(double up, double length);
 
-/// Fills the packing statistics of `c` from the ratios d / estimate of each angle bin: mean and
-/// sample standard deviation per bin, all pairs' for a bin with fewer than kPackingMinPairs, and
-/// 1 and 0 when there is no pair at all (the hulls' own distance).
-void packing_statistics(const std::array<std::vector<double>, 3>& ratios, BodyContactData& c);
+/// A touching pair of a reference pile: d / the runtime's hull distance, and the candidate the
+/// runtime's search names (0: the line of centres; else 1 + a face of either body, as
+/// statsim::detail::hull_candidate numbers them for two bodies of one shape).
+struct PackingSample {
+  double ratio = 1.0;
+  double up = 0.0;  ///< vertical component of the unit line of centres
+  std::uint32_t witness = 0;
+};
+
+/// Fills the packing statistics of `c` (its faces already in place, ratio entries overwritten):
+/// pairs touching along a face give that face's mean ratio, pairs touching along their line of
+/// centres the angle bins' mean and sample standard deviation. A bin or face with fewer than
+/// kPackingMinPairs pairs takes the pooled statistics of its kind (line or faces), or of all
+/// pairs when its kind has too few too; 1 and 0 when there is no pair at all (the hulls' own
+/// distance).
+void packing_statistics(const std::vector<PackingSample>& samples, BodyContactData& c);
 
 /// "ContactData<D, NH, S, K>" (or ContactDataQ16 when `i16`).
 std::string contact_type(const BodyContactData& c, bool i16);

@@ -159,6 +159,7 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
   statsim::WorldDef2 def;
   def.restitution_threshold = sig.restitution_threshold;  // as Box2D's (1 m/s)
   def.pile_rest = o.pile_rest;
+  def.body_contacts = statsim::BodyContacts::hulls;  // the tables' body-body data (README, "Hull contacts")
   auto world = std::make_unique<StatWorld>(def);
   if (world->construction_status() != statsim::Status::ok) {
     throw std::runtime_error("statsim world rejected its parameters");

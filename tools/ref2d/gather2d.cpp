@@ -567,8 +567,9 @@ Gather2dResult run_rest_poses(const Gather2dOptions& options)
 namespace {
 
 // d / (the runtime's contact distance along the line of centres) of a touching pile pair: the
-// least candidate distance that `find_hull_witness` finds on the table's own data, packing 1.
-double packing_ratio_of(const statsim::Shape<2>& shape, const Pile2dContact& c)
+// least candidate distance that `find_hull_witness` finds on the table's own data, packing 1;
+// with the candidate it found.
+PackingSample packing_sample(const statsim::Shape<2>& shape, const Pile2dContact& c)
 {
   statsim::Body<2> a{}, b{};
   a.orientation = statsim::Rot2::from_angle(static_cast<statsim::Scalar>(c.angle_a));
@@ -579,7 +580,11 @@ double packing_ratio_of(const statsim::Shape<2>& shape, const Pile2dContact& c)
   std::uint32_t k = statsim::detail::find_hull_witness(shape, a, shape, b, e, statsim::Scalar(0), statsim::Scalar(1));
   if (k == statsim::detail::no_witness) k = 0;
   const statsim::detail::HullCandidate<2> h = statsim::detail::hull_candidate(shape, a, shape, b, e, k);
-  return ab.norm() / (static_cast<double>(h.reach) / static_cast<double>(h.normal.dot(e)));
+  PackingSample p;
+  p.ratio = ab.norm() / (static_cast<double>(h.reach) / static_cast<double>(h.normal.dot(e)));
+  p.up = ab.y() / ab.norm();
+  p.witness = k;
+  return p;
 }
 
 // 4. Body-body data (statsim::ContactView): pair distance, support map, hull edges, packing.
@@ -615,7 +620,9 @@ void body_contacts_experiment(const Context& ctx, Gather2dResult& r)
   std::stable_sort(edges.begin(), edges.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
   c.hull_faces = static_cast<int>(edges.size());
   const std::size_t k = std::min(edges.size(), static_cast<std::size_t>(o.contact_faces));
-  for (std::size_t i = 0; i < k; ++i) c.faces.insert(c.faces.end(), {edges[i].second.x(), edges[i].second.y(), edges[i].second.z()});
+  // The packing ratio of each edge (its last number) is measured below; 1 until then.
+  for (std::size_t i = 0; i < k; ++i)
+    c.faces.insert(c.faces.end(), {edges[i].second.x(), edges[i].second.y(), edges[i].second.z(), 1.0});
 
   // The table's own body-body data, as the runtime reads it from the header being written.
   std::vector<float> support, faces;
@@ -647,16 +654,15 @@ void body_contacts_experiment(const Context& ctx, Gather2dResult& r)
         asleep[i] = all ? 1 : 0;
       },
       o.threads);
-  std::array<std::vector<double>, 3> ratios;
+  std::vector<PackingSample> samples;
   for (std::size_t i = 0; i < piles.size(); ++i) {
     c.asleep += asleep[i];
     c.pile_steps += o.packing_steps;
     for (const Pile2dContact& pc : piles[i]) {
-      const Eigen::Vector2d ab = pc.cb - pc.ca;
-      ratios[static_cast<std::size_t>(packing_bin(ab.y(), ab.norm()))].push_back(packing_ratio_of(shape, pc));
+      samples.push_back(packing_sample(shape, pc));
     }
   }
-  packing_statistics(ratios, c);
+  packing_statistics(samples, c);
   c.packing_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 }
 

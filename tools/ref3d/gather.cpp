@@ -409,8 +409,9 @@ struct StoredSupport {
 };
 
 // d / (the runtime's contact distance along the line of centres) of a touching pile pair: the
-// least candidate distance that `find_hull_witness` finds on the table's own data, packing 1.
-double packing_ratio_of(const Shape<3>& shape, const PileContact& c)
+// least candidate distance that `find_hull_witness` finds on the table's own data, packing 1;
+// with the candidate it found.
+PackingSample packing_sample(const Shape<3>& shape, const PileContact& c)
 {
   Body<3> a{}, b{};
   a.orientation = c.a.orientation.cast<Scalar>().normalized();
@@ -421,7 +422,11 @@ double packing_ratio_of(const Shape<3>& shape, const PileContact& c)
   std::uint32_t k = statsim::detail::find_hull_witness(shape, a, shape, b, e, Scalar(0), Scalar(1));
   if (k == statsim::detail::no_witness) k = 0;
   const statsim::detail::HullCandidate<3> h = statsim::detail::hull_candidate(shape, a, shape, b, e, k);
-  return ab.norm() / (static_cast<double>(h.reach) / static_cast<double>(h.normal.dot(e)));
+  PackingSample p;
+  p.ratio = ab.norm() / (static_cast<double>(h.reach) / static_cast<double>(h.normal.dot(e)));
+  p.up = ab.z() / ab.norm();
+  p.witness = k;
+  return p;
 }
 
 // 4. Body-body data (statsim::ContactView): pair distance, support map, faces, packing.
@@ -453,7 +458,9 @@ void gather_body_contacts(GatherResult& r)
   const std::vector<double> offsets = face_offsets(m, normals);
   c.hull_faces = static_cast<int>(normals.size());
   const std::size_t k = std::min(normals.size(), static_cast<std::size_t>(o.contact_faces));
-  for (std::size_t i = 0; i < k; ++i) c.faces.insert(c.faces.end(), {normals[i].x(), normals[i].y(), normals[i].z(), offsets[i]});
+  // The packing ratio of each face (its last number) is measured below; 1 until then.
+  for (std::size_t i = 0; i < k; ++i)
+    c.faces.insert(c.faces.end(), {normals[i].x(), normals[i].y(), normals[i].z(), offsets[i], 1.0});
 
   // The table's own body-body data, as the runtime reads it from the header being written.
   StoredSupport stored;
@@ -494,16 +501,15 @@ void gather_body_contacts(GatherResult& r)
       },
       o.threads);
   progress.finish();
-  std::array<std::vector<double>, 3> ratios;
+  std::vector<PackingSample> samples;
   for (const ReferencePile& p : piles) {
     c.asleep += p.asleep ? 1 : 0;
     c.pile_steps += p.steps;
     for (const PileContact& pc : p.contacts) {
-      const Eigen::Vector3d ab = pc.b.position - pc.a.position;
-      ratios[static_cast<std::size_t>(packing_bin(ab.z(), ab.norm()))].push_back(packing_ratio_of(shape, pc));
+      samples.push_back(packing_sample(shape, pc));
     }
   }
-  packing_statistics(ratios, c);
+  packing_statistics(samples, c);
   c.packing_seconds = seconds_since(t1);
 }
 
@@ -922,7 +928,7 @@ std::vector<std::string> body_contact_lines(const GatherResult& r)
   l.push_back("support map S = " + std::to_string(c.support_size) + " (" +
               std::to_string(6 * c.support_size * c.support_size) + " values, " + (o.i16 ? "i16" : "f32") +
               "; at most " + fmt("%.3g", c.support_bound) + " m above the hull's support), " +
-              std::to_string(c.faces.size() / 4) + " of the hull's " + std::to_string(c.hull_faces) +
+              std::to_string(c.face_count()) + " of the hull's " + std::to_string(c.hull_faces) +
               " faces, mesh frame from the principal axes and centre of mass");
   l.push_back("pair distance: " + std::to_string(c.pair_flights) + " pair flights (" + std::to_string(o.pair_trials) +
               " per h_coll spin ratio, head-on at " + num(o.speed) + " m/s relative speed)");

@@ -187,7 +187,8 @@ void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::
   expect_size(s.contact.pair_mean, s.height_axis.size(), "body_contacts.pair_mean", origin);
   expect_size(s.contact.pair_stddev, s.height_axis.size(), "body_contacts.pair_stddev", origin);
   s.contact.faces = numbers(c, "faces", origin, "body_contacts.");
-  if (s.contact.faces.size() % 4 != 0) fail(origin, "field 'body_contacts.faces' must hold 4 numbers a face");
+  if (s.contact.faces.size() % statsim::face_values(3) != 0)
+    fail(origin, "field 'body_contacts.faces' must hold 5 numbers a face (normal, offset, packing ratio)");
   const std::vector<Scalar> pm = numbers(c, "packing_mean", origin, "body_contacts.");
   const std::vector<Scalar> ps = numbers(c, "packing_stddev", origin, "body_contacts.");
   expect_size(pm, 3, "body_contacts.packing_mean", origin);

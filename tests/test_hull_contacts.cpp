@@ -1,0 +1,159 @@
+// Body-body contacts at the shapes' hulls (statsim/hull_contact.hpp, BodyContacts::hulls) with the
+// committed tables' body-body data: the support map against the closed form, stacks that hold
+// their true height, and piles that end asleep, above the ground and without overlaps.
+#include "statsim/statsim.hpp"
+#include "tables/box.hpp"
+#include "tables/lshape.hpp"
+#include "tables/lshape2d.hpp"
+#include "tables/square2d.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+
+using namespace statsim;
+
+namespace {
+
+// The deepest overlap of any touching pair as a fraction of the separation at which it touches
+// (the runtime's own hull contact, found afresh), and the lowest point of any hull below the
+// plane z = 0 (2D: y = 0), m (negative: below).
+template <int D, class World>
+void pile_state(const World& w, Scalar& overlap, Scalar& lowest)
+{
+  using Vec = typename Space<D>::Vec;
+  overlap = 0;
+  lowest = 1e9f;
+  const Vec down = -Vec::Unit(Space<D>::up_axis);
+  for (std::uint32_t i = 0; i < w.body_count(); ++i) {
+    const Body<D>& a = w.body(i);
+    const Shape<D>& sa = w.shape(ShapeId(a.shape));
+    const Scalar low = a.position[Space<D>::up_axis] -
+                       detail::support_along(sa.signature.contact, detail::to_body(a.orientation, down));
+    lowest = low < lowest ? low : lowest;
+    for (std::uint32_t j = i + 1; j < w.body_count(); ++j) {
+      const Body<D>& b = w.body(j);
+      const Shape<D>& sb = w.shape(ShapeId(b.shape));
+      const Vec d = b.position - a.position;
+      const Scalar dist = d.norm();
+      const Vec e = d / dist;
+      const Scalar packing = sa.largest_packing > sb.largest_packing ? sa.largest_packing : sb.largest_packing;
+      const std::uint32_t k = detail::find_hull_witness(sa, a, sb, b, e, dist, packing);
+      if (k == detail::no_witness) continue;
+      const detail::HullCandidate<D> h = detail::hull_candidate(sa, a, sb, b, e, k);
+      const Scalar reach = (k == 0 ? detail::pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
+      const Scalar f = (reach - d.dot(h.normal)) / reach;
+      overlap = f > overlap ? f : overlap;
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("hull contacts: the box table's support map is the cube's closed form")
+{
+  const ContactView<3>& c = tables::box.view().contact;
+  REQUIRE(c.present());
+  REQUIRE(c.face_count == 6u);
+  // s(u) = 0.1 (|u_x| + |u_y| + |u_z|) for a cube of half side 0.1 m; the map is exact on a cube
+  // (its creases lie on grid lines) up to the 16-bit storage.
+  const Vector3 dirs[] = {Vector3(1, 0, 0), Vector3(0, -1, 0), Vector3(1, 1, 1).normalized(),
+                          Vector3(0.3f, -0.8f, 0.52f).normalized(), Vector3(-0.9f, 0.1f, -0.42f).normalized()};
+  for (const Vector3& u : dirs) {
+    const Scalar expected = Scalar(0.1) * (std::fabs(u.x()) + std::fabs(u.y()) + std::fabs(u.z()));
+    CHECK(detail::support_along(c, u) == doctest::Approx(expected).epsilon(1e-3));
+  }
+  for (std::uint32_t k = 0; k < c.face_count; ++k) {
+    CHECK(c.faces[k * face_values(3) + 3] == doctest::Approx(0.1).epsilon(1e-6));
+    CHECK(c.faces[k * face_values(3) + 4] == doctest::Approx(1.0).epsilon(0.02));  // convex: no nesting
+  }
+}
+
+TEST_CASE("hull contacts: a column of 10 cubes placed face to face holds its height and sleeps")
+{
+  for (const BodyContacts mode : {BodyContacts::hulls, BodyContacts::collision_spheres}) {
+    CAPTURE(int(mode));
+    WorldDef3 def;
+    def.body_contacts = mode;
+    auto w = std::make_unique<World3<16>>(def);
+    const ShapeId box = w->add_shape(tables::box.view()).id;
+    REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).status == Status::ok);
+    for (int i = 0; i < 10; ++i) {
+      BodyDef3 b;
+      b.shape = box;
+      b.mass = 8;
+      b.position = Vector3(0, 0, Scalar(0.1) + Scalar(0.2) * Scalar(i));
+      REQUIRE(w->add_body(b).status == Status::ok);
+    }
+    for (int s = 0; s < 180; ++s) REQUIRE(w->step(Scalar(1) / 60).ok());
+    Scalar top = 0;
+    bool asleep = true;
+    for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+      top = w->body(i).position.z() > top ? w->body(i).position.z() : top;
+      asleep = asleep && w->body(i).state == MotionState::asleep;
+    }
+    if (mode == BodyContacts::hulls) {
+      CHECK(std::fabs(top / Scalar(1.9) - 1) < Scalar(0.02));
+      CHECK(asleep);
+    } else {
+      CHECK(top / Scalar(1.9) > Scalar(1.2));  // the paper's spheres: 2 h_coll a cube
+    }
+  }
+}
+
+TEST_CASE("hull contacts: a 3D pile of boxes and L-shapes ends asleep, above the ground, without overlaps")
+{
+  WorldDef3 def;
+  def.body_contacts = BodyContacts::hulls;
+  auto w = std::make_unique<World3<60>>(def);
+  const ShapeId shapes[] = {w->add_shape(tables::box.view()).id, w->add_shape(tables::lshape.view()).id};
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).status == Status::ok);
+  Pcg32 rng(7, 1);
+  for (int i = 0; i < 60; ++i) {
+    BodyDef3 b;
+    b.shape = shapes[i % 2];
+    b.mass = 1;
+    b.position = Vector3(Scalar(0.25) * Scalar(i % 4), Scalar(0.25) * Scalar((i / 4) % 4), Scalar(0.3) + Scalar(0.3) * Scalar(i / 16));
+    b.orientation = Quaternion(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f).normalized();
+    REQUIRE(w->add_body(b).status == Status::ok);
+  }
+  for (int s = 0; s < 900; ++s) REQUIRE(w->step(Scalar(1) / 60).ok());
+  std::uint32_t asleep = 0;
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) asleep += w->body(i).state == MotionState::asleep ? 1u : 0u;
+  CHECK(asleep == w->body_count());
+  Scalar overlap, lowest;
+  pile_state<3>(*w, overlap, lowest);
+  CHECK(overlap < Scalar(0.05));
+  CHECK(lowest > Scalar(-0.002));
+}
+
+TEST_CASE("hull contacts: a 2D pile of squares and L-shapes ends asleep, above the ground, without overlaps")
+{
+  WorldDef2 def;
+  def.body_contacts = BodyContacts::hulls;
+  auto w = std::make_unique<World2<100>>(def);
+  const ShapeId shapes[] = {w->add_shape(tables::square2d.view()).id, w->add_shape(tables::lshape2d.view()).id};
+  REQUIRE(w->add_plane(Vector2(0, 1), 0).status == Status::ok);
+  Pcg32 rng(3, 1);
+  for (int i = 0; i < 100; ++i) {
+    BodyDef2 b;
+    b.shape = shapes[i % 2];
+    b.mass = 1;
+    b.position = Vector2(Scalar(1.6) * Scalar(i % 10) - 8, Scalar(1) + Scalar(1.6) * Scalar(i / 10));
+    b.orientation = Rot2::from_angle(Scalar(6.283185) * rng.uniform());
+    REQUIRE(w->add_body(b).status == Status::ok);
+  }
+  for (int s = 0; s < 900; ++s) REQUIRE(w->step(Scalar(1) / 60).ok());
+  std::uint32_t asleep = 0;
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) asleep += w->body(i).state == MotionState::asleep ? 1u : 0u;
+  Scalar overlap, lowest;
+  pile_state<2>(*w, overlap, lowest);
+  CHECK(lowest > Scalar(-0.01));
+  // The aim is every body asleep and overlaps under 5%, as in 3D; mixed 2D piles do not reach it
+  // yet (pairs of sleepers keep deeper overlaps: tools/ref2d/README.md, "Hull contacts"), so
+  // these bounds only keep it from getting worse.
+  CHECK(asleep + 3 >= w->body_count());
+  CHECK(overlap < Scalar(0.2));
+}
