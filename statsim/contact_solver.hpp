@@ -260,59 +260,6 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
   return contacts;
 }
 
-/// True when two bodies touch at their hulls (`BodyContacts::hulls`, both shapes with a hull, at
-/// least one statistical).
-template <int D>
-bool hull_pair(const WorldData<D>& w, const Body<D>& a, const Body<D>& b)
-{
-  const Shape<D>& sa = w.shapes[a.shape];
-  const Shape<D>& sb = w.shapes[b.shape];
-  return w.def.body_contacts == BodyContacts::hulls && has_hull(sa) && has_hull(sb) &&
-         (sa.statistical || sb.statistical);
-}
-
-/// Whether the pair touches and how: at their collision spheres, or (`BodyContacts::hulls`,
-/// both shapes with a hull) along a hull candidate, searched afresh when `fresh` (the impact
-/// pass) and else the one the impact pass found. `slop_fraction`: spheres grown by this fraction
-/// of the reach. Fills the contact and the reach (separation along the normal at which they
-/// touch, m).
-template <int D>
-bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, bool fresh, Scalar slop_fraction,
-                  Contact<D>& c, Scalar& reach, Scalar& slop)
-{
-  using Vec = typename Space<D>::Vec;
-  const Shape<D>& sa = w.shapes[a.shape];
-  const Shape<D>& sb = w.shapes[b.shape];
-  if (!hull_pair(w, a, b)) {
-    reach = a.radius + b.radius;
-    slop = reach * slop_fraction;
-    return sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c);
-  }
-  const Vec d = b.position - a.position;
-  const Scalar dist2 = d.squaredNorm();
-  const Scalar bound = a.bounding_radius + b.bounding_radius;
-  if (!(dist2 < bound * bound)) return false;
-  const Scalar dist = std::sqrt(dist2);
-  // Coincident centres: any direction is as good; up keeps it defined and deterministic.
-  const Vec e = dist > bound * Scalar(1e-6) ? Vec(d / dist) : Vec(Vec::Unit(Space<D>::up_axis));
-  if (fresh) {
-    const Scalar pa = sa.statistical ? sa.largest_packing : Scalar(1);
-    const Scalar pb = sb.statistical ? sb.largest_packing : Scalar(1);
-    pair.witness = find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb);
-    if (pair.witness == no_witness) return false;
-  } else if (pair.witness == no_witness) {
-    return false;
-  }
-  const HullCandidate<D> h = hull_candidate(sa, a, sb, b, e, pair.witness);
-  reach = (pair.witness == 0 ? pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
-  slop = reach * slop_fraction;
-  const Scalar depth = reach + slop - d.dot(h.normal);
-  if (!(depth > 0)) return false;
-  c.normal = h.normal;
-  c.depth = depth;
-  return true;
-}
-
 /// The shared loop over body-body contacts among the first `count` candidate pairs (grown by
 /// `contact_slop` of their reach when `grown`; the impact pass, not grown, finds each pair's
 /// hull contact afresh). For each touching pair it calls `resolve(a, b, contact, slop, reach)`,

@@ -37,7 +37,7 @@ TEST_CASE("format 2.0: an older table loads without body-body data and steps as 
     std::uint64_t h = 1469598103934665603ull;
     for (std::uint32_t i = 0; i < w->body_count(); ++i) {
       const Body3& b = w->body(i);
-      for (int d = 0; d < 3; ++d) h = (h ^ std::uint64_t(std::uint32_t(b.position[d] * 1e6f))) * 1099511628211ull;
+      for (int d = 0; d < 3; ++d) h = (h ^ std::uint64_t(std::int64_t(b.position[d] * 1e6f))) * 1099511628211ull;
     }
     hashes[k++] = h;
   }
