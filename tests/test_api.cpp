@@ -5,6 +5,7 @@
 
 #include "scenes/synthetic_signatures.hpp"
 
+#include "statsim/mesh_pose.hpp"
 #include "statsim/random.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
@@ -174,4 +175,41 @@ TEST_CASE("a build without contraction constructs worlds with status ok")
   bad.sleep_time = -1;
   World3<2> v(bad);
   CHECK(v.construction_status() == Status::invalid_parameter);
+}
+
+namespace {
+/// A view with a mesh frame, as tables that record one have.
+struct FramedView {
+  const Scalar* mesh_frame;
+};
+}  // namespace
+
+TEST_CASE("a mesh is placed at a body's pose through the table's mesh frame")
+{
+  // Mesh frame: the body's x axis is the mesh's y axis (R rows: (0 1 0), (-1 0 0), (0 0 1)),
+  // the centre of mass at c = (1, 2, 3) in mesh coordinates.
+  const Scalar frame[12] = {0, 1, 0, -1, 0, 0, 0, 0, 1, 1, 2, 3};
+  const FramedView framed{frame};
+  const Vector3 x(5, -1, 2);
+  const Quaternion q(Eigen::AngleAxisf(0.7f, Vector3(1, 2, 2).normalized()));
+  const auto t = mesh_to_world(framed, x, q);
+  const Vector3 m(1.5f, 2.25f, 2.5f);
+  const Eigen::Matrix3f r = (Eigen::Matrix3f() << 0, 1, 0, -1, 0, 0, 0, 0, 1).finished();
+  const Vector3 expected = x + q * (r * (m - Vector3(1, 2, 3)));
+  CHECK((t * m - expected).norm() < 1e-5f);
+  CHECK((t * Vector3(1, 2, 3) - x).norm() < 1e-5f);  // the centre of mass is at the body's position
+
+  // A table without a mesh frame: body frame = mesh frame.
+  const auto plain = mesh_to_world(testing::cube_synthetic.view(), x, q);
+  CHECK((plain * m - (x + q * m)).norm() < 1e-5f);
+
+  // 2D, from a body.
+  const Scalar frame2[6] = {0, -1, 1, 0, 0.5f, 0};
+  const FramedView framed2{frame2};
+  Body2 b{};
+  b.position = Vector2(1, 1);
+  b.orientation = Rot2{0, 1};  // a quarter turn
+  const auto t2 = mesh_to_world(framed2, b);
+  // m = (0.5, 1): body point R (m - c) = (0 -1; 1 0) (0, 1) = (-1, 0); turned: (0, -1); + (1, 1).
+  CHECK((t2 * Vector2(0.5f, 1) - Vector2(1, 0)).norm() < 1e-6f);
 }
