@@ -35,9 +35,10 @@
 
 /// 1: the default assert handler prints "FILE:LINE: statsim assertion failed: EXPRESSION" to
 /// stderr, then aborts. 0: it only traps, needing no stdio (whose buffers allocate on bare-metal
-/// C libraries). Default: 1 on an operating system (Unix, macOS, Windows), 0 elsewhere.
+/// C libraries, and imports system calls into WebAssembly). Default: 1 on an operating system
+/// (Unix, macOS, Windows), 0 elsewhere (bare metal, WebAssembly).
 #ifndef STATSIM_ASSERT_MESSAGE
-#if defined(__unix__) || defined(__APPLE__) || defined(_WIN32)
+#if (defined(__unix__) || defined(__APPLE__) || defined(_WIN32)) && !defined(__EMSCRIPTEN__)
 #define STATSIM_ASSERT_MESSAGE 1
 #else
 #define STATSIM_ASSERT_MESSAGE 0
