@@ -143,6 +143,7 @@ int main(int argc, char** argv)
   for (long i = 0; i < 2 * n; ++i) {
     BodyDef2 b;
     b.shape = shapes[i % 2];
+    b.mass = 1;  // kg, both shapes alike, as the committed picture was made (the tables' masses differ)
     const float x = rng.uniform(-0.6f * half_width, 0.6f * half_width);
     const float y = rng.uniform(1, 1 + 0.15f * float(n));
     const float angle = rng.uniform(-3.14159265f, 3.14159265f);
