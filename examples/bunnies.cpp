@@ -58,7 +58,7 @@ int main(int argc, char** argv)
   def.seed = o.seed;
   // A cylinder wide enough for a low pile: radius grows with sqrt(N).
   const float radius = 0.1f * std::sqrt(float(o.n));
-  statsim::ShapeId shape = 0;
+  statsim::ShapeId shape{};
   if (!demo::drop("bunnies", world, def, statsim::tables::bunny.view(), {o.n, radius, 0.3f, 2.0f / float(o.n) + 0.0004f},
                   0, shape))
     return 1;

@@ -84,7 +84,7 @@ inline void summary(const char* name, const WorldCore3& w, ShapeId shape, int st
   std::uint32_t hist[256] = {}, none = 0, count = 0;
   for (std::uint32_t i = 0; i < w.body_count(); ++i) {
     const Body3& b = w.body(i);
-    if (b.shape != shape) continue;
+    if (b.shape != shape.index) continue;
     ++count;
     if (b.rest_pose == no_rest_pose || b.state != MotionState::asleep) ++none;
     else ++hist[b.rest_pose];
@@ -137,7 +137,7 @@ inline int drop_main(int argc, char** argv, WorldCore3& w, const DropDemo& d)
   def.seed = o.seed;
   tools::scenes::CylinderDrop drop = d.drop;
   drop.count = o.n;
-  ShapeId shape = 0;
+  ShapeId shape{};
   if (!demo::drop(d.name, w, def, d.signature, drop, 0, shape)) return 1;
   int steps = 0;
   const double ms = run(w, o, steps);

@@ -143,6 +143,7 @@ int main(int argc, char** argv)
   for (long i = 0; i < 2 * n; ++i) {
     BodyDef2 b;
     b.shape = shapes[i % 2];
+    b.mass = 1;  // kg, both shapes alike, as the committed picture was made (the tables' masses differ)
     const float x = rng.uniform(-0.6f * half_width, 0.6f * half_width);
     const float y = rng.uniform(1, 1 + 0.15f * float(n));
     const float angle = rng.uniform(-3.14159265f, 3.14159265f);
@@ -191,7 +192,7 @@ int main(int argc, char** argv)
     std::vector<int> hist(sig.rest.count + 1, 0);
     for (std::uint32_t i = 0; i < world.body_count(); ++i) {
       const Body2& b = world.body(i);
-      if (b.shape != shapes[s]) continue;
+      if (b.shape != shapes[s].index) continue;
       ++hist[b.rest_pose == no_rest_pose ? sig.rest.count : b.rest_pose];
     }
     std::printf("  %s rest poses:", sig.name);
@@ -212,7 +213,7 @@ int main(int argc, char** argv)
              ground);
     for (std::uint32_t i = 0; i < world.body_count(); ++i) {
       const Body2& b = world.body(i);
-      const int s = b.shape == shapes[0] ? 0 : 1;
+      const int s = b.shape == shapes[0].index ? 0 : 1;
       std::vector<Vector2> poly;
       for (const Vector2& p : outlines[s].points) {
         const Vector2 q = b.orientation * p + b.position;  // world, metres; y up

@@ -36,7 +36,7 @@ int main(int argc, char** argv)
     def.rest_conditions = k == 1;
     statsim::World3<1>& w = worlds[k];
     // One bunny on the cylinder's axis at 0.6 m.
-    statsim::ShapeId shape = 0;
+    statsim::ShapeId shape{};
     if (!demo::drop("rest_conditions", w, def, sig, {1, 0.0f, 0.6f, 0.0f}, 7, shape)) return 1;
     int steps = 0;
     demo::Options run = o;

@@ -18,7 +18,10 @@
 
 /// 1: STATSIM_ASSERT checks internal invariants and calls the assert handler on failure.
 /// 0: the checks compile to nothing. Default: 1 unless NDEBUG is defined.
-/// Bad input from callers is never an assertion: it is a Status, in every build.
+/// Bad input from callers is never an assertion: it is a Status, in every build. The one
+/// exception is an id past the end handed to an accessor that returns a reference
+/// (`WorldCore::body()`, `plane()`, `shape()`): a bug in the caller, asserted, and memory-safe
+/// where assertions are off; `WorldCore::find_body()` is the checked lookup.
 #ifndef STATSIM_ENABLE_ASSERT
 #ifdef NDEBUG
 #define STATSIM_ENABLE_ASSERT 0
@@ -28,6 +31,25 @@
 #endif
 #if STATSIM_ENABLE_ASSERT != 0 && STATSIM_ENABLE_ASSERT != 1
 #error "STATSIM_ENABLE_ASSERT must be 0 or 1"
+#endif
+
+/// 1: the default assert handler prints "FILE:LINE: statsim assertion failed: EXPRESSION" to
+/// stderr, then aborts. 0: it only traps, needing no stdio (whose buffers allocate on bare-metal
+/// C libraries, and imports system calls into WebAssembly). Default: 1 on an operating system
+/// (Unix, macOS, Windows), 0 elsewhere (bare metal, WebAssembly).
+#ifndef STATSIM_ASSERT_MESSAGE
+#if (defined(__unix__) || defined(__APPLE__) || defined(_WIN32)) && !defined(__EMSCRIPTEN__)
+#define STATSIM_ASSERT_MESSAGE 1
+#else
+#define STATSIM_ASSERT_MESSAGE 0
+#endif
+#endif
+#if STATSIM_ASSERT_MESSAGE != 0 && STATSIM_ASSERT_MESSAGE != 1
+#error "STATSIM_ASSERT_MESSAGE must be 0 or 1"
+#endif
+#if STATSIM_ASSERT_MESSAGE
+#include <cstdio>
+#include <cstdlib>
 #endif
 
 /// Version of the layout of generated signature tables. A table generated for another version
@@ -43,14 +65,24 @@ namespace statsim {
 /// The floating-point type of every quantity in the runtime. Tables are generated for it.
 using Scalar = float;
 
-/// Called when an internal invariant fails (a bug in statsim, not bad input).
-/// `expression`, `file` and `line` name the failed check. The default handler traps; firmware
-/// can log and reset, a host test can record. A handler may return, in which case the runtime
-/// carries on (the result is then unspecified, but memory-safe).
+/// Called when an internal invariant fails (a bug in statsim, or an id past the end, see
+/// STATSIM_ENABLE_ASSERT). `expression`, `file` and `line` name the failed check. The default
+/// handler prints them and aborts (see STATSIM_ASSERT_MESSAGE; without it, it traps);
+/// firmware can log and reset, a host test can record. A handler may return, in which case the
+/// runtime carries on (the result is then unspecified, but memory-safe).
 using AssertHandler = void (*)(const char* expression, const char* file, int line);
 
 namespace detail {
+#if STATSIM_ASSERT_MESSAGE
+[[noreturn]] inline void default_assert_handler(const char* expression, const char* file, int line)
+{
+  std::fprintf(stderr, "%s:%d: statsim assertion failed: %s\n", file, line, expression);
+  std::fflush(stderr);
+  std::abort();
+}
+#else
 [[noreturn]] inline void default_assert_handler(const char*, const char*, int) { __builtin_trap(); }
+#endif
 inline AssertHandler& assert_handler_slot()
 {
   static AssertHandler handler = &default_assert_handler;
@@ -65,6 +97,24 @@ inline AssertHandler set_assert_handler(AssertHandler handler)
   detail::assert_handler_slot() = handler ? handler : &detail::default_assert_handler;
   return previous;
 }
+
+namespace detail {
+/// True when the code that includes this header is compiled to fuse a multiply and an add into
+/// one rounding (`-ffp-contract=fast`, gcc's default outside ISO mode, or `on`, clang's, with
+/// FMA hardware) or to keep excess precision (x87): either changes results in the last bits, and
+/// so the hashes. With x = 1 + 2^-12 and c = 1 + 2^-11, x * x = 1 + 2^-11 + 2^-24 exactly; rounded
+/// to float that is a tie, to even, c; so x * x - c is 0 when the product is rounded and 2^-24
+/// when it is fused with the subtraction (or held wider). The volatile reads keep the compiler
+/// from folding the expression at compile time, where it would round as the language says.
+inline bool float_contraction()
+{
+  volatile Scalar x_in = Scalar(1) + Scalar(1) / Scalar(4096);
+  volatile Scalar c_in = Scalar(1) + Scalar(1) / Scalar(2048);
+  const Scalar x = x_in;
+  const Scalar c = c_in;
+  return x * x - c != 0;
+}
+}  // namespace detail
 
 }  // namespace statsim
 

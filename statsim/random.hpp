@@ -108,4 +108,48 @@ constexpr std::uint64_t body_stream(std::uint64_t seed, std::uint32_t index)
   return mix64(seed ^ mix64(0x5747a7u + std::uint64_t(index)));
 }
 
+namespace detail {
+/// A point drawn uniformly from the unit disc without its centre, by rejection; `s` = x^2 + y^2.
+inline void disc_point(Pcg32& rng, float& x, float& y, float& s)
+{
+  do {
+    const float du = rng.uniform();  // one draw per statement: see gaussian_pair
+    const float dv = rng.uniform();
+    x = 2.0f * du - 1.0f;
+    y = 2.0f * dv - 1.0f;
+    s = x * x + y * y;
+  } while (s >= 1.0f || s == 0.0f);
+}
+}  // namespace detail
+
+/// An orientation drawn uniformly over all rotations (body to world, unit length; the Haar
+/// measure), from `rng`: for bodies dropped in random poses. Uses only square roots, which IEEE
+/// arithmetic rounds exactly, so every platform draws the same bits. Consumes a variable number
+/// of draws, always the same for the same state.
+template <int D>
+typename Space<D>::Rot random_orientation(Pcg32& rng);
+
+/// 3D: Marsaglia's uniform point on the 3-sphere (1972), which is a uniform unit quaternion. With
+/// (x1, y1) and (x2, y2) uniform in the unit disc, s1 and s2 their squared lengths, the point
+/// (x1, y1, x2 f, y2 f) with f = sqrt((1 - s1) / s2) has length^2 s1 + s2 (1 - s1) / s2 = 1.
+template <>
+inline Quaternion random_orientation<3>(Pcg32& rng)
+{
+  float x1, y1, s1, x2, y2, s2;
+  detail::disc_point(rng, x1, y1, s1);
+  detail::disc_point(rng, x2, y2, s2);
+  const float f = std::sqrt((1.0f - s1) / s2);
+  return Quaternion(x1, y1, x2 * f, y2 * f);  // (w, x, y, z)
+}
+
+/// 2D: a uniform point of the unit disc, scaled to the unit circle: a uniform angle.
+template <>
+inline Rot2 random_orientation<2>(Pcg32& rng)
+{
+  float x, y, s;
+  detail::disc_point(rng, x, y, s);
+  const float r = std::sqrt(s);
+  return {x / r, y / r};
+}
+
 }  // namespace statsim

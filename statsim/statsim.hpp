@@ -5,6 +5,7 @@
 #include "statsim/config.hpp"
 #include "statsim/status.hpp"
 #include "statsim/math.hpp"
+#include "statsim/mesh_pose.hpp"
 #include "statsim/random.hpp"
 #include "statsim/broadphase.hpp"
 #include "statsim/contact.hpp"

@@ -14,15 +14,19 @@ enum class [[nodiscard]] Status : std::uint8_t {
   non_finite,            ///< a position, velocity, mass, radius or gravity was NaN or infinite
   zero_quaternion,       ///< orientation had (near) zero length
   non_unit_quaternion,   ///< orientation length differed from 1 by more than 1e-3
-  invalid_time_step,     ///< dt was not finite and positive
+  invalid_time_step,     ///< dt was not finite and positive, or above `limits::time_step` (1 s)
   invalid_plane,         ///< plane normal was zero or not finite, or offset not finite
   invalid_radius,        ///< a radius was not positive, or bounding radius < collision radius
-  invalid_mass,          ///< mass was not positive
+  invalid_mass,          ///< mass was not positive (or 0 with a shape that records none)
   invalid_material,      ///< restitution outside [0, 1] or friction negative
-  invalid_shape,         ///< shape id does not name a shape of this world
+  invalid_shape,         ///< shape id does not name a shape of this world (another world's, or past the end), or a malformed signature
   invalid_body,          ///< body id does not name a body of this world
   invalid_parameter,     ///< a world parameter is out of its documented range
   out_of_range,          ///< a finite value beyond the runtime's limits (`statsim::limits`)
+  /// Only from `WorldCore::construction_status()`: this build fuses multiply and add (or keeps
+  /// excess precision), so results are valid but not bit-identical to other builds. Compile
+  /// with `-ffp-contract=off` (the CMake targets add it).
+  float_contraction,
 };
 
 /// Short, stable name of a status, for messages ("capacity_exceeded").
@@ -43,6 +47,7 @@ constexpr const char* to_string(Status s)
     case Status::invalid_body: return "invalid_body";
     case Status::invalid_parameter: return "invalid_parameter";
     case Status::out_of_range: return "out_of_range";
+    case Status::float_contraction: return "float_contraction";
   }
   return "unknown";
 }

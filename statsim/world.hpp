@@ -31,9 +31,20 @@
 #include "statsim/world_def.hpp"
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 
 namespace statsim {
+
+namespace detail {
+/// A tag for a new world, 1 to 65535 (0 is the bare-index tag of `ShapeId`). Worlds made one after
+/// another get different tags until 65535 have been made; the tag never enters a simulation.
+inline std::uint16_t next_world_tag()
+{
+  static std::atomic<std::uint32_t> made{0};
+  return std::uint16_t(made.fetch_add(1, std::memory_order_relaxed) % 65535u + 1u);
+}
+}  // namespace detail
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
 template <int D>
@@ -55,32 +66,40 @@ class WorldCore {
     return s;
   }
   const WorldDef<D>& def() const { return w_.def; }
-  /// Status of the parameters given at construction: if not ok, the world uses the defaults.
+  /// Status of the construction. `ok`; or why the parameters given were refused (the world then
+  /// uses the defaults); or, with valid parameters, `float_contraction`: this build fuses
+  /// floating-point operations (see `detail::float_contraction`), so the world works but its
+  /// results differ in the last bits from builds with `-ffp-contract=off` (the CMake targets).
   Status construction_status() const { return construction_status_; }
+  /// This world's tag, carried by the shape ids it issues (`ShapeId::world`), 1 to 65535.
+  std::uint16_t tag() const { return tag_; }
 
-  /// Registers a shape. Fails with `capacity_exceeded` when the shape pool is full.
+  /// Registers a plain sphere shape. Rejected with `non_finite`, `invalid_radius`,
+  /// `invalid_mass`, `invalid_material` or `out_of_range` on bad input, with
+  /// `capacity_exceeded` when the shape pool is full.
   Added<ShapeId> add_shape(const ShapeDef& def)
   {
     const Scalar bound = def.bounding_radius == 0 ? def.radius : def.bounding_radius;
     const Status s = detail::check_shape_def(def, bound);
-    if (s != Status::ok) return {s, 0};
-    if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, 0};
-    w_.shapes[w_.shape_count] =
-        Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {}, def.radius, 0, def.radius, 1};
-    return {Status::ok, ShapeId(w_.shape_count++)};
+    if (s != Status::ok) return {s, ShapeId{}};
+    if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, ShapeId{}};
+    w_.shapes[w_.shape_count] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {},
+                                         def.radius, 0, def.radius, 1, def.mass};
+    return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
   }
 
   /// Registers a statistical shape from its signature (`tables::NAME.view()`). The view is
   /// copied; the tables it points to must outlive the world (generated tables are static).
   /// Rejected with `invalid_shape` if the signature is malformed (a pointer missing for a count
-  /// above 0, a number out of its range) or has more than `max_rest_poses` rest poses. Computes
+  /// above 0, a number out of its range) or has more than `max_rest_poses` rest poses, and with
+  /// `out_of_range` if its mass (the default mass of its bodies) is beyond `limits`. Computes
   /// the rest-pose basins (`rest_basin_biases`), which takes a while for a shape with many rest
   /// poses: add shapes while setting up, not during steps.
   Added<ShapeId> add_shape(const SignatureView<D>& sig)
   {
     const Status s = detail::check_signature(sig);
-    if (s != Status::ok) return {s, 0};
-    if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, 0};
+    if (s != Status::ok) return {s, ShapeId{}};
+    if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, ShapeId{}};
     // The broad phase must hold every radius a body can take: the largest h_coll and h_rest.
     Scalar largest = sig.bounding_radius, rest_max = 0;
     for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i)
@@ -102,7 +121,8 @@ class WorldCore {
     // times the largest packing ratio.
     Scalar floor = 0, packing = 1;
     Shape<D>& shape = w_.shapes[w_.shape_count];
-    shape = Shape<D>{0, largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig), floor, packing};
+    shape = Shape<D>{0,         largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig),
+                     floor,     packing, sig.mass};
     if (sig.contact.present()) {
       const detail::SupportBounds sb = detail::support_bounds(sig.contact);
       packing = detail::largest_packing(shape);
@@ -112,7 +132,7 @@ class WorldCore {
       shape.largest_packing = packing;
     }
     rest_basin_biases<D>(sig, shape.rest_bias.data());
-    return {Status::ok, ShapeId(w_.shape_count++)};
+    return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
   }
 
   /// Adds a static plane with the given normal (any length > 0; it is normalised) through the
@@ -128,19 +148,23 @@ class WorldCore {
     return {Status::ok, PlaneId(w_.plane_count++)};
   }
 
-  /// Adds a body. Fails, adding nothing, on bad input or when the body pool is full.
+  /// Adds a body. Fails, adding nothing, on bad input (`non_finite`, `zero_quaternion`,
+  /// `non_unit_quaternion`, `out_of_range`; `invalid_shape` for a shape id of another world or
+  /// past the last shape; `invalid_mass` for a mass that is not positive, or 0 with a shape that
+  /// has no mass) or with `capacity_exceeded` when the body pool is full.
   Added<BodyId> add_body(const BodyDef<D>& def)
   {
     const Status s = detail::check_state<D>(def.position, def.orientation, def.linear_velocity, def.angular_velocity);
     if (s != Status::ok) return {s, 0};
-    if (def.shape >= w_.shape_count) return {Status::invalid_shape, 0};
-    if (!detail::finite(def.mass)) return {Status::non_finite, 0};
-    if (!(def.mass > 0)) return {Status::invalid_mass, 0};
-    if (def.mass < limits::min_mass || def.mass > limits::max_mass) return {Status::out_of_range, 0};
+    if (!owns(def.shape)) return {Status::invalid_shape, 0};
+    const Shape<D>& shape = w_.shapes[def.shape.index];
+    const Scalar mass = def.mass == 0 ? shape.mass : def.mass;
+    if (!detail::finite(mass)) return {Status::non_finite, 0};
+    if (!(mass > 0)) return {Status::invalid_mass, 0};
+    if (mass < limits::min_mass || mass > limits::max_mass) return {Status::out_of_range, 0};
     if (w_.body_count == w_.max_bodies) return {Status::capacity_exceeded, 0};
 
     const BodyId id = w_.body_count;
-    const Shape<D>& shape = w_.shapes[def.shape];
     Body<D>& b = w_.bodies[id];
     b.position = def.position;
     b.orientation = detail::normalized(def.orientation);
@@ -150,11 +174,11 @@ class WorldCore {
                    ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
                    : shape.radius;
     b.bounding_radius = shape.bounding_radius;
-    b.inv_mass = Scalar(1) / def.mass;
+    b.inv_mass = Scalar(1) / mass;
     b.slow_time = 0;
     b.step_start = b.position;
     b.rng_state = Pcg32(w_.def.seed, body_stream(w_.def.seed, id)).state();
-    b.shape = def.shape;
+    b.shape = def.shape.index;
     b.state = def.asleep ? MotionState::asleep : MotionState::moving;
     b.touching = false;
     b.on_ground = false;
@@ -191,8 +215,9 @@ class WorldCore {
     return Status::ok;
   }
 
-  /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` if dt
-  /// is not finite and positive or exceeds `limits::time_step` (1 s); then nothing changes.
+  /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` (not
+  /// `out_of_range`) if dt is not finite and positive or exceeds `limits::time_step` (1 s); then
+  /// nothing changes.
   /// Overflow of the pair buffer is reported in the result, never silent.
   StepResult step(Scalar dt)
   {
@@ -243,22 +268,34 @@ class WorldCore {
   /// rate is energy_clamp_count() / statistical_response_count().
   std::uint64_t statistical_response_count() const { return w_.statistical_responses; }
 
-  /// A body's state. `id` must be < body_count() (checked by STATSIM_ASSERT).
+  /// A body's state. `id` must be < body_count(): a caller's bug otherwise, reported by
+  /// STATSIM_ASSERT where assertions are on; where they are off the call reads the first slot
+  /// of the body storage instead of memory past it (meaningless, but memory-safe). For an id
+  /// that may be bad, use `find_body`.
   const Body<D>& body(BodyId id) const
   {
     STATSIM_ASSERT(id < w_.body_count);
-    return w_.bodies[id];
+    return w_.bodies[id < w_.body_count ? id : 0];
   }
+  /// A body's state, or nullptr if `id` is not < body_count().
+  [[nodiscard]] const Body<D>* find_body(BodyId id) const { return id < w_.body_count ? &w_.bodies[id] : nullptr; }
+  /// A plane. `id` must be < plane_count(), as for `body()`.
   const Plane<D>& plane(PlaneId id) const
   {
     STATSIM_ASSERT(id < w_.plane_count);
-    return w_.planes[id];
+    return w_.planes[id < w_.plane_count ? id : 0];
   }
+  /// A shape. `id` must name a shape of this world (`owns`), as for `body()`.
   const Shape<D>& shape(ShapeId id) const
   {
-    STATSIM_ASSERT(id < w_.shape_count);
-    return w_.shapes[id];
+    STATSIM_ASSERT(owns(id));
+    return w_.shapes[owns(id) ? id.index : 0];
   }
+  /// The shape of a body (`Body::shape`, an index), as for `body()`.
+  const Shape<D>& shape_of(const Body<D>& b) const { return shape(ShapeId(b.shape)); }
+  /// True when `id` names a shape of this world: below shape_count(), with this world's tag or
+  /// none (a bare index).
+  bool owns(ShapeId id) const { return id.index < w_.shape_count && (id.world == 0 || id.world == tag_); }
   /// Candidate pairs of the last step: the broad phase's pairs, up to the pair capacity, in the
   /// order the contact solver left them (the pairs that touched first; with shock propagation
   /// those sorted from the bottom up).
@@ -305,12 +342,14 @@ class WorldCore {
            s.max_shapes}
   {
     construction_status_ = configure(def);
+    if (construction_status_ == Status::ok && detail::float_contraction()) construction_status_ = Status::float_contraction;
   }
   ~WorldCore() = default;
 
  private:
   detail::WorldData<D> w_;
   Status construction_status_ = Status::ok;
+  std::uint16_t tag_ = detail::next_world_tag();
 };
 
 namespace detail {

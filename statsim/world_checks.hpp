@@ -43,7 +43,9 @@ inline Status check_shape_def(const ShapeDef& def, Scalar bound)
     return Status::non_finite;
   if (!(def.radius > 0) || bound < def.radius) return Status::invalid_radius;
   if (def.radius < limits::min_radius || bound > limits::max_radius) return Status::out_of_range;
-  if (!finite(def.material.rolling_resistance)) return Status::non_finite;
+  if (!finite(def.mass) || !finite(def.material.rolling_resistance)) return Status::non_finite;
+  if (!(def.mass > 0)) return Status::invalid_mass;
+  if (def.mass < limits::min_mass || def.mass > limits::max_mass) return Status::out_of_range;
   if (def.material.restitution < 0 || def.material.restitution > 1 || def.material.friction < 0 ||
       def.material.rolling_resistance < 0)
     return Status::invalid_material;
@@ -129,8 +131,12 @@ Status check_signature_values(const SignatureView<D>& sig)
   };
   const Material& m = sig.material;
   if (bad(m.restitution) || bad(m.friction) || bad(m.rolling_resistance) || bad(sig.restitution_threshold) ||
-      bad(sig.mass) || bad(sig.unit_inertia[0]) || bad(sig.unit_inertia[1]) || bad(sig.unit_inertia[2]))
+      !finite(sig.mass) || bad(sig.unit_inertia[0]) || bad(sig.unit_inertia[1]) || bad(sig.unit_inertia[2]))
     return Status::non_finite;
+  // The mass is the default of every body made from the table: it must be one add_body accepts.
+  // 0 stands for "not recorded" (then bodies must give theirs).
+  if (sig.mass < 0) return Status::invalid_mass;
+  if (sig.mass > 0 && (sig.mass < limits::min_mass || sig.mass > limits::max_mass)) return Status::out_of_range;
   if (m.rolling_resistance < 0 || sig.restitution_threshold < 0) return Status::invalid_material;
   if (sig.unit_inertia[0] < 0 || sig.unit_inertia[1] < 0 || sig.unit_inertia[2] < 0) return Status::invalid_shape;
   const HeightTableView& h = sig.height;

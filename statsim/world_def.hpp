@@ -40,8 +40,18 @@ inline bool within(Scalar x, Scalar bound) { return std::fabs(x) <= bound; }
 
 /// Index of a body in its world, in order of creation.
 using BodyId = std::uint32_t;
-/// Index of a shape in its world, in order of creation.
-using ShapeId = std::uint16_t;
+/// Names a shape of one world: its index in order of creation and the tag of the world that
+/// made it. `add_shape` returns tagged ids, and a world rejects a tagged id of another world with
+/// `Status::invalid_shape`, so an id cannot silently mean another world's shape. `ShapeId{}` and
+/// `ShapeId(index)` are bare indices (tag 0), valid in any world that has that many shapes.
+struct ShapeId {
+  std::uint16_t index = 0;  ///< position in the world's shapes, in order of creation
+  std::uint16_t world = 0;  ///< tag of the world that issued it (`WorldCore::tag()`); 0: any world
+  constexpr ShapeId() = default;
+  constexpr explicit ShapeId(std::uint16_t i, std::uint16_t tag = 0) : index(i), world(tag) {}
+  constexpr bool operator==(const ShapeId& o) const { return index == o.index && world == o.world; }
+  constexpr bool operator!=(const ShapeId& o) const { return !(*this == o); }
+};
 /// Index of a plane in its world, in order of creation.
 using PlaneId = std::uint16_t;
 
@@ -62,6 +72,9 @@ struct ShapeDef {
   Scalar bounding_radius = 0;
   /// Restitution and friction of the shape's surface.
   Material material{};
+  /// Mass a body of this shape gets when its `BodyDef::mass` is 0, kg, in
+  /// [`limits::min_mass`, `limits::max_mass`].
+  Scalar mass = 1;
 };
 
 /// Initial state of a body.
@@ -72,8 +85,11 @@ struct BodyDef {
   typename Space<D>::Rot orientation = Space<D>::identity();  ///< body to world; unit length
   Vec linear_velocity = Vec::Zero();                          ///< m/s
   typename Space<D>::Spin angular_velocity = Space<D>::zero_spin();  ///< rad/s, world frame
-  ShapeId shape = 0;                                          ///< from `add_shape`
-  Scalar mass = 1;                                            ///< kg, > 0
+  ShapeId shape{};                                            ///< from `add_shape`
+  /// kg. 0 (the default): the shape's mass, the table's `Signature::mass` for a statistical
+  /// shape (the reference body's, set by the mesh and the gathering's density) or
+  /// `ShapeDef::mass` for a sphere. Otherwise > 0, in [`limits::min_mass`, `limits::max_mass`].
+  Scalar mass = 0;
   bool asleep = false;                                        ///< start asleep (e.g. a pre-built pile)
 };
 
@@ -214,7 +230,7 @@ struct Body {
   Vec step_start;                         ///< m, centre at the start of the last step (for the sleep test)
   std::uint64_t rng_state;                ///< state of the body's PCG32 stream
   Scalar rest_blend;                      ///< 0: radius is h_coll; 1: radius is h_rest of rest_pose
-  ShapeId shape;
+  std::uint16_t shape;                    ///< index of the body's shape (`ShapeId::index`)
   MotionState state;
   bool touching;                          ///< touched a plane or body in the last step
   bool on_ground;                         ///< touched a near-horizontal plane in the last step
@@ -259,6 +275,8 @@ struct Shape {
   /// The largest packing ratio of the table's body-body data (`detail::largest_packing`); 1
   /// without it.
   Scalar largest_packing;
+  /// Mass of a body whose `BodyDef::mass` is 0, kg: the signature's, or `ShapeDef::mass`.
+  Scalar mass;
 };
 
 }  // namespace statsim

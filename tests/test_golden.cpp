@@ -30,6 +30,7 @@ std::uint64_t run_scene(World& w, const Sig& sig)
   for (int i = 0; i < 150; ++i) {
     BodyDef<D> b;
     b.shape = i % 3 == 0 ? sphere : stat;
+    b.mass = 1;  // kg, not the table's (the scene predates shape masses)
     for (int k = 0; k < D; ++k) {
       const float x = g.uniform(-1.5f, 1.5f);
       b.position[k] = x;

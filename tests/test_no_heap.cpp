@@ -147,7 +147,7 @@ TEST_CASE("no heap allocation in construction and stepping of a 10000-body stati
   Pcg32 g(3, 4);
   for (std::uint32_t i = 0; i < N_big; ++i) {
     BodyDef3 b;
-    b.shape = ShapeId(i % 3);
+    b.shape = ShapeId(std::uint16_t(i % 3));
     b.position = Vector3(g.uniform(-5, 5), g.uniform(-5, 5), g.uniform(0.2f, 3));
     b.angular_velocity = Vector3(g.uniform(-5, 5), 0, g.uniform(-5, 5));
     REQUIRE(w->add_body(b).ok());

@@ -82,10 +82,10 @@ TEST_CASE("bad input is rejected with its status and the world is unchanged (3D)
   d.orientation = Quaternion(nan_f, 0, 0, 0);
   expect_rejected(d, Status::non_finite);
   d = ok;
-  d.shape = 5;
+  d.shape = ShapeId(5);
   expect_rejected(d, Status::invalid_shape);
   d = ok;
-  d.mass = 0;
+  d.mass = -1;
   expect_rejected(d, Status::invalid_mass);
   d = ok;
   d.mass = nan_f;

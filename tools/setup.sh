@@ -19,7 +19,7 @@ packages=(g++ make cmake libeigen3-dev)
 if [ "$minimal" = 0 ]; then
   # Tests (doctest), host tools (reference engines, command line, JSON, images, meshes).
   packages+=(doctest-dev libbox2d-dev libbullet-dev libcli11-dev nlohmann-json3-dev
-             libstb-dev libmeshoptimizer-dev libtinyobjloader-dev)
+             libstb-dev libmeshoptimizer-dev libtinyobjloader-dev libassimp-dev)
   # The firmware example and its test: Cortex-M toolchain, C and C++ libraries, and the emulator.
   packages+=(gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm)
   # The web example and its tests (examples/web): emscripten for the .wasm, Debian's chromium for

@@ -211,7 +211,7 @@ std::uint32_t demo_hash_low()
 /// Bounding radius of the current shape, m (what the page draws a body's size from).
 float demo_body_size()
 {
-  return current == square ? core2().shape(0).bounding_radius : core3().shape(0).bounding_radius;
+  return current == square ? core2().shape(statsim::ShapeId(0)).bounding_radius : core3().shape(statsim::ShapeId(0)).bounding_radius;
 }
 
 /// Fills the transform buffer (8 floats per body, see `transforms`) and returns its address.

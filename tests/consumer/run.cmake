@@ -1,5 +1,7 @@
 # Installs statsim into a temporary prefix, then configures, builds and runs a small project that
-# finds it with find_package(statsim). Run by CTest (test install_and_consume).
+# finds it with find_package(statsim), generating a table from a mesh at build time when the
+# tools were built; then the same project through add_subdirectory. Run by CTest (test
+# install_and_consume).
 foreach(var SOURCE_DIR WORK_DIR GENERATOR CXX)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run.cmake needs -D${var}=...")
@@ -25,6 +27,17 @@ if(NOT EXISTS "${prefix}/include/statsim/world3.hpp")
   message(FATAL_ERROR "headers were not installed")
 endif()
 
+# The host tool, installed as the component `tools` from the main build (TOOLS_BUILD_DIR, when
+# it has the tools): the consumer then generates a table at build time with statsim_add_tables.
+set(with_tools OFF)
+if(TOOLS_BUILD_DIR AND EXISTS "${TOOLS_BUILD_DIR}/bin/statsim")
+  run(${CMAKE_COMMAND} --install "${TOOLS_BUILD_DIR}" --component tools --prefix "${prefix}")
+  if(NOT EXISTS "${prefix}/lib/cmake/statsim/statsimToolsTargets.cmake" OR NOT EXISTS "${prefix}/bin/statsim")
+    message(FATAL_ERROR "the tools component did not install bin/statsim and statsimToolsTargets.cmake")
+  endif()
+  set(with_tools ON)
+endif()
+
 run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${WORK_DIR}/consumer" -G "${GENERATOR}"
     -DCMAKE_CXX_COMPILER=${CXX} -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/consumer")
@@ -33,3 +46,28 @@ if(NOT last_output MATCHES "consumer: ok")
   message(FATAL_ERROR "consumer printed: ${last_output}")
 endif()
 message(STATUS "${last_output}")
+if(with_tools)
+  if(NOT EXISTS "${WORK_DIR}/consumer/consumer_tables_tables/statsim/tables/block.hpp")
+    message(FATAL_ERROR "statsim_add_tables generated no table")
+  endif()
+  run("${WORK_DIR}/consumer/consumer_own")
+  if(NOT last_output MATCHES "consumer_own: ok")
+    message(FATAL_ERROR "consumer_own printed: ${last_output}")
+  endif()
+  message(STATUS "${last_output}")
+  # Built again with nothing changed, the table is not generated again.
+  run(${CMAKE_COMMAND} --build "${WORK_DIR}/consumer")
+  if(last_output MATCHES "statsim gather")
+    message(FATAL_ERROR "the table was generated again with nothing changed:\n${last_output}")
+  endif()
+endif()
+
+# The same project through add_subdirectory: the same includes (<statsim/...>, <statsim/tables/...>).
+run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${WORK_DIR}/subdirectory" -G "${GENERATOR}"
+    -DCMAKE_CXX_COMPILER=${CXX} -DSTATSIM_SOURCE_DIR=${SOURCE_DIR} -DCMAKE_BUILD_TYPE=Release)
+run(${CMAKE_COMMAND} --build "${WORK_DIR}/subdirectory")
+run("${WORK_DIR}/subdirectory/consumer")
+if(NOT last_output MATCHES "consumer: ok")
+  message(FATAL_ERROR "consumer (add_subdirectory) printed: ${last_output}")
+endif()
+message(STATUS "add_subdirectory: ${last_output}")

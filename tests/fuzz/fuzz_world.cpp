@@ -134,7 +134,7 @@ void run(Input& in, BroadPhase broad_phase)
         b.orientation = rot(in, Space<D>{});
         b.linear_velocity = vec<D>(in, 50);
         b.angular_velocity = spin(in, Space<D>{}, 200);
-        b.shape = ShapeId(in.below(5));
+        b.shape = ShapeId(std::uint16_t(in.below(5)));
         b.mass = in.value(10);
         b.asleep = in.below(8) == 0;
         s = world.add_body(b).status;

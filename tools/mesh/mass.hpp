@@ -22,6 +22,10 @@
 
 namespace statsim::tools {
 
+/// Density of a shape when none is given, kg/m^3 (about water, plastics, wood): `statsim mesh
+/// info` and `statsim gather` both use it.
+constexpr double default_density = 1000.0;
+
 struct MassProperties {
   double volume = 0.0;                       ///< m^3 (mesh units cubed)
   double density = 1.0;                      ///< kg/m^3

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// Closed triangle meshes for the host tools: a validated OBJ reader and an OBJ writer.
+/// Closed triangle meshes for the host tools: a validated OBJ reader, other formats through
+/// assimp (`load_mesh`), the check of units, and an OBJ writer.
 ///
 /// Reading goes through tinyobjloader. tinyobjloader is lenient (it reads "nan" or "abc" as 0,
 /// skips unknown statements and faces with bad indices), so `load_obj` first checks every line
@@ -40,6 +41,28 @@ struct MeshError {
 /// face with fewer than 3 vertices, degenerate triangle, open / non-manifold / inconsistently
 /// wound surface, zero or negative volume.
 bool load_obj(const std::string& path, TriMesh& mesh, MeshError& error);
+
+/// Loads and validates a mesh file by its extension: `.obj` through `load_obj` (every line
+/// checked), anything else (STL, PLY, glTF / GLB, ...) through assimp, with node transforms
+/// applied, polygons triangulated, vertices at bit-identical positions welded (STL stores one
+/// per face corner), then `validate_mesh`. Coordinates are taken as they are in the file.
+bool load_mesh(const std::string& path, TriMesh& mesh, MeshError& error);
+
+/// Metres per unit of a unit name: m, cm, mm, in, ft. False for any other name.
+bool units_scale(const std::string& units, double& scale);
+
+/// Multiplies every coordinate by `scale` (metres per file unit).
+void scale_mesh(TriMesh& mesh, double scale);
+
+/// Meshes are in metres, and a shape the tools can gather spans between these, m (the largest
+/// side of its bounding box).
+constexpr double min_mesh_size = 0.01;
+constexpr double max_mesh_size = 10.0;
+
+/// Refuses a mesh whose largest bounding-box side lies outside [`min_mesh_size`,
+/// `max_mesh_size`] m, with a message that says how to give its units, unless `units_given`
+/// (the user said what a unit is with --units or --scale).
+bool check_mesh_size(const TriMesh& mesh, const std::string& name, bool units_given, MeshError& error);
 
 /// As `load_obj`, reading OBJ text; `name` prefixes the messages in place of the file name.
 bool parse_obj(const std::string& text, const std::string& name, TriMesh& mesh, MeshError& error);

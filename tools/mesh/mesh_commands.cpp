@@ -93,12 +93,16 @@ int write_obj(const std::string& command, const std::string& path, const TriMesh
 
 }  // namespace
 
-int mesh_info(const std::string& file, double density, std::ostream& out, std::ostream& err)
+int mesh_info(const std::string& file, double density, std::ostream& out, std::ostream& err, double scale,
+              bool units_given)
 {
   if (!(density > 0.0) || !std::isfinite(density)) return fail(err, "info", "--density must be positive");
+  if (!(scale > 0.0) || !std::isfinite(scale)) return fail(err, "info", "--scale must be positive");
   TriMesh mesh;
   MeshError e;
-  if (!load_obj(file, mesh, e)) return fail(err, "info", e.message);
+  if (!load_mesh(file, mesh, e)) return fail(err, "info", e.message);
+  if (scale != 1.0) scale_mesh(mesh, scale);
+  if (!check_mesh_size(mesh, file, units_given, e)) return fail(err, "info", e.message);
   const MassProperties mp = compute_mass_properties(mesh, density);
   Eigen::Vector3d lo, hi;
   bounding_box(mesh, lo, hi);
@@ -320,11 +324,21 @@ void register_mesh_commands(CLI::App& app)
 
   {
     auto file = std::make_shared<std::string>();
-    auto density = std::make_shared<double>(1.0);
-    CLI::App* sub = mesh->add_subcommand("info", "Validate an OBJ mesh and print its mass properties");
-    sub->add_option("file", *file, "OBJ file")->required();
-    sub->add_option("--density", *density, "uniform density (default 1: mass = volume)");
-    sub->callback([=] { run(mesh_info(*file, *density, std::cout, std::cerr)); });
+    auto density = std::make_shared<double>(default_density);
+    auto units = std::make_shared<std::string>();
+    auto scale = std::make_shared<double>(1.0);
+    CLI::App* sub = mesh->add_subcommand("info", "Validate a mesh (OBJ, STL, PLY, glTF/GLB, ...) and print its mass "
+                                                 "properties");
+    sub->add_option("file", *file, "mesh file, in metres")->required();
+    sub->add_option("--density", *density, "uniform density, kg/m^3 (statsim gather's default)")->capture_default_str();
+    auto* u = sub->add_option("--units", *units, "unit of the coordinates: m, cm, mm, in or ft")
+                  ->check(CLI::IsMember({"m", "cm", "mm", "in", "ft"}));
+    auto* s = sub->add_option("--scale", *scale, "metres per unit of the coordinates (instead of --units)")->excludes(u);
+    sub->callback([=] {
+      double metres = *scale;
+      if (!units->empty()) units_scale(*units, metres);
+      run(mesh_info(*file, *density, std::cout, std::cerr, metres, !units->empty() || s->count() > 0));
+    });
   }
   {
     auto in = std::make_shared<std::string>();

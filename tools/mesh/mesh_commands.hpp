@@ -10,9 +10,12 @@
 
 namespace statsim::tools {
 
-/// `mesh info FILE.obj [--density RHO]`: counts, volume, mass, centre of mass, inertia, principal
-/// moments and axes, bounding radius.
-int mesh_info(const std::string& file, double density, std::ostream& out, std::ostream& err);
+/// `mesh info FILE [--density RHO] [--units U | --scale S]`: counts, volume, mass, centre of mass,
+/// inertia, principal moments and axes, bounding radius, of the mesh scaled by `scale` (metres
+/// per file unit); refused, as by `statsim gather`, when it spans less than 1 cm or more than
+/// 10 m and `units_given` is false.
+int mesh_info(const std::string& file, double density, std::ostream& out, std::ostream& err, double scale = 1.0,
+              bool units_given = false);
 
 /// `mesh decimate --in A.obj --out B.obj --vertices N`.
 int mesh_decimate(const std::string& in, const std::string& out_file, int vertices, std::ostream& out,

@@ -210,7 +210,7 @@ void validate_gather_options(const GatherOptions& o)
 
 ShapeModel build_model(const GatherOptions& o)
 {
-  if (o.box_size.empty()) return load_shape_model(o.shape, o.mesh_file, o.density);
+  if (o.box_size.empty()) return load_shape_model(o.shape, o.mesh_file, o.density, o.mesh_scale, o.mesh_units_given);
   ShapeModel m = make_box_model(Eigen::Vector3d(o.box_size[0], o.box_size[1], o.box_size[2]), o.density);
   m.source = "generated " + num(o.box_size[0]) + " x " + num(o.box_size[1]) + " x " + num(o.box_size[2]) + " m box";
   return m;

@@ -57,7 +57,9 @@ std::vector<double> default_coarse_speeds();   ///< the coarse speed axis, m/s
 
 struct GatherOptions {
   std::string shape = "box";  ///< box, lshape, bunny (ignored when mesh_file is set)
-  std::string mesh_file;      ///< any closed OBJ (btGImpactMeshShape)
+  std::string mesh_file;      ///< any closed mesh `load_mesh` reads (btGImpactMeshShape)
+  double mesh_scale = 1.0;    ///< metres per unit of mesh_file (--scale, --units)
+  bool mesh_units_given = false;  ///< --scale or --units was given: no check of the mesh's size
   std::vector<double> box_size;  ///< non-empty: a generated box of this size (m), btBoxShape
   std::string name;           ///< table name (a C++ identifier)
   bool with_speed = false;    ///< response layout: false = scaled (cos theta, cos phi, s), true = with speed
@@ -72,7 +74,7 @@ struct GatherOptions {
   int empirical_outcomes = 16;
   unsigned threads = 0;       ///< 0 = all hardware threads
   bool progress = false;      ///< progress and ETA on stderr
-  double density = 1000.0;    ///< kg/m^3
+  double density = default_density;  ///< kg/m^3
   double speed = 2.0;         ///< |V-| of the scaled layout's impacts, m/s
   double rolling_resistance = 0.05;  ///< written to the signature's material (the runtime's spheres)
   double max_impact_time = 2.0;      ///< s of an impact before it counts as time-limited

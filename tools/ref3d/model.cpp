@@ -144,13 +144,15 @@ ShapeModel make_box_model(const Eigen::Vector3d& size, double density, const std
   return m;
 }
 
-ShapeModel load_shape_model(const std::string& shape, const std::string& mesh_file, double density)
+ShapeModel load_shape_model(const std::string& shape, const std::string& mesh_file, double density, double scale,
+                            bool units_given)
 {
+  if (!(scale > 0) || !std::isfinite(scale)) throw std::runtime_error("--scale must be positive");
   if (!(density > 0) || !std::isfinite(density)) throw std::runtime_error("density must be positive");
   std::string path = mesh_file, label = mesh_file, name;
   if (mesh_file.empty()) {
     if (shape != "box" && shape != "lshape" && shape != "bunny")
-      throw std::runtime_error("unknown shape '" + shape + "' (box, lshape, bunny, or --mesh FILE.obj)");
+      throw std::runtime_error("unknown shape '" + shape + "' (box, lshape, bunny, or --mesh FILE)");
     path = meshes_directory() + "/" + shape + ".obj";
     label = "tools/meshes/" + shape + ".obj";
     name = shape;
@@ -164,7 +166,11 @@ ShapeModel load_shape_model(const std::string& shape, const std::string& mesh_fi
   }
   TriMesh mesh;
   MeshError error;
-  if (!load_obj(path, mesh, error)) throw std::runtime_error(error.message);
+  if (!load_mesh(path, mesh, error)) throw std::runtime_error(error.message);
+  if (!mesh_file.empty()) {
+    if (scale != 1.0) scale_mesh(mesh, scale);
+    if (!check_mesh_size(mesh, path, units_given, error)) throw std::runtime_error(error.message);
+  }
   const std::string bytes = read_file_bytes(path);
 
   ShapeModel m;

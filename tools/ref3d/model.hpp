@@ -56,9 +56,12 @@ std::uint64_t fnv1a64(const std::string& bytes);
 std::string meshes_directory();
 
 /// Builds the model of a built-in shape ("box", "lshape", "bunny": tools/meshes/NAME.obj) or of
-/// any OBJ file (`mesh_file` non-empty, `shape` ignored). Throws std::runtime_error with a message
+/// any mesh file (`mesh_file` non-empty, `shape` ignored). Throws std::runtime_error with a message
 /// naming the problem (unknown shape, unreadable or invalid mesh, a box mesh that is not a box).
-ShapeModel load_shape_model(const std::string& shape, const std::string& mesh_file, double density);
+/// A mesh file (`mesh_file`, any format `load_mesh` reads) is scaled by `scale`, metres per file
+/// unit, and must then span 1 cm to 10 m (`check_mesh_size`) unless `units_given`.
+ShapeModel load_shape_model(const std::string& shape, const std::string& mesh_file, double density,
+                            double scale = 1.0, bool units_given = false);
 
 /// A box of full size `size` (m) as a model (btBoxShape); `name` labels it.
 ShapeModel make_box_model(const Eigen::Vector3d& size, double density, const std::string& name = "box");

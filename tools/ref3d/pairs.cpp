@@ -311,6 +311,7 @@ PairOutcome runtime_pair_impact(const SignatureView<3>& sig, double L, const std
     const RigidState& st = k ? s.second : s.first;
     BodyDef3& b = def_[k];
     b.shape = shape;
+    b.mass = 1;  // kg, both alike as before bodies took the table's mass (the same bits as then)
     b.orientation = st.orientation.cast<Scalar>();
     b.linear_velocity = st.velocity.cast<Scalar>();
     b.angular_velocity = st.spin.cast<Scalar>();

@@ -5,12 +5,17 @@
 #include "ref3d/cell_report.hpp"
 #include "ref3d/gather.hpp"
 #include "ref3d/pairs.hpp"
+#include "ref3d/signature_json.hpp"
 #include "ref3d/sizing.hpp"
+#include "mesh/mesh.hpp"
+
+#include "statsim/world_def.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -46,6 +51,7 @@ struct GatherCommand {
   std::string mesh_shape = "gimpact";
   std::string out;
   std::string json;
+  std::string units;        ///< --units NAME (m, cm, mm, in, ft)
   std::string cell_report;  ///< markdown file; its JSON beside it (.json)
   std::vector<std::string> model_json;  ///< MODEL=FILE: the same gathering's JSON with another model
   bool quiet = false;
@@ -158,6 +164,27 @@ GatherResult gather_sized(const GatherCommand& c, const GatherOptions& o, std::o
   return sized_result(dense, s, notes);
 }
 
+// The shape's mass and size become the table's, which add_shape and add_body check against the
+// runtime's limits: a shape beyond them is refused here, before any trial runs.
+void check_model_limits(const GatherOptions& o)
+{
+  const ShapeModel m = build_model(o);
+  const auto g = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", x);
+    return std::string(buf);
+  };
+  const std::string what = m.source.empty() ? m.name : m.source;
+  if (!(m.mass.mass >= double(limits::min_mass) && m.mass.mass <= double(limits::max_mass)))
+    throw std::runtime_error(what + ": mass " + g(m.mass.mass) + " kg (density " + g(o.density) +
+                             " kg/m^3) is outside the runtime's " + g(double(limits::min_mass)) + " to " +
+                             g(double(limits::max_mass)) + " kg: check the mesh's units (--units, --scale) and --density");
+  if (!(m.bounding_radius >= double(limits::min_radius) && m.bounding_radius <= double(limits::max_radius)))
+    throw std::runtime_error(what + ": bounding radius " + g(m.bounding_radius) + " m is outside the runtime's " +
+                             g(double(limits::min_radius)) + " to " + g(double(limits::max_radius)) +
+                             " m: check the mesh's units (--units, --scale)");
+}
+
 void run(const GatherCommand& c, const CLI::App& sub)
 {
   std::ostream& out = *c.out_stream;
@@ -170,7 +197,11 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.response_model = parse_response_model(c.response_model);
     o.reference.mesh_hull = c.mesh_shape == "hull";
     o.body_contacts = !c.no_body_contacts;
+    if (!c.units.empty() && !units_scale(c.units, o.mesh_scale))
+      throw std::runtime_error("--units '" + c.units + "': expected m, cm, mm, in or ft");
+    o.mesh_units_given = !c.units.empty() || sub.get_option("--scale")->count() > 0;
     validate_gather_options(o);
+    check_model_limits(o);
     if (c.speed_check || c.step_check || c.settings_check) {
       std::string report;
       if (c.settings_check) report += settings_check_report(o) + "\n";
@@ -215,6 +246,9 @@ void run(const GatherCommand& c, const CLI::App& sub)
     if (c.size_for_scene) r = gather_sized(c, o, out);
     else r = gather(o);
     const std::string header = header_text(r, command);
+    // The runtime's own checks on the numbers written (its add_shape on the same table read
+    // back from JSON): a table it would refuse is never written.
+    parse_signature_json(json_text(r, command), c.out);
     if (!c.json.empty()) write_file_atomic(c.json, json_text(r, command));
     if (!c.cell_report.empty()) {
       const CellReport report = cell_report(r);
@@ -265,8 +299,16 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   auto* shape = sub->add_option("--shape", o.shape, "Built-in shape: box, lshape or bunny (tools/meshes/NAME.obj)")
                     ->check(CLI::IsMember({"box", "lshape", "bunny"}))
                     ->capture_default_str();
-  auto* mesh = sub->add_option("--mesh", o.mesh_file, "Any closed, outward-wound OBJ mesh (btGImpactMeshShape)")
+  auto* mesh = sub->add_option("--mesh", o.mesh_file,
+                               "Any closed, outward-wound mesh in metres: OBJ, STL, PLY, glTF/GLB or another format "
+                               "assimp reads (btGImpactMeshShape)")
                    ->excludes(shape);
+  auto* units = sub->add_option("--units", c->units, "Unit of the mesh's coordinates: m, cm, mm, in or ft")
+                    ->check(CLI::IsMember({"m", "cm", "mm", "in", "ft"}))
+                    ->needs(mesh);
+  sub->add_option("--scale", o.mesh_scale, "Metres per unit of the mesh's coordinates (instead of --units)")
+      ->excludes(units)
+      ->needs(mesh);
   sub->add_option("--box-size", o.box_size, "A box of this size X,Y,Z in m instead (btBoxShape)")
       ->delimiter(',')
       ->expected(3)

@@ -32,6 +32,7 @@ inline Status drop_cylinder(WorldCore3& w, ShapeId shape, const CylinderDrop& dr
   for (long i = 0; i < drop.count; ++i) {
     BodyDef3 b;
     b.shape = shape;
+    b.mass = 1;  // kg, every body alike (the figures measured with these scenes used 1 kg)
     const float a = rng.uniform(0, 6.2831853f);
     const float r = drop.radius * std::sqrt(rng.uniform());
     const float z = drop.base + drop.rise * float(i) + rng.uniform(0, drop.rise);

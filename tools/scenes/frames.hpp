@@ -60,7 +60,7 @@ void write_frame(std::FILE* f, const World& w, int step, double time)
 {
   for (std::uint32_t i = 0; i < w.body_count(); ++i) {
     const auto& b = w.body(i);
-    const auto& shape = w.shape(b.shape);
+    const auto& shape = w.shape_of(b);
     const char* name = shape.statistical ? shape.signature.name : "sphere";
     if constexpr (World::Vec::RowsAtCompileTime == 3)
       write_frame_row(f, step, time, i, name, b.position.template cast<double>(), b.orientation.template cast<double>(),
