@@ -330,13 +330,17 @@ TEST_CASE("gather2d: the command rejects bad input with an error and writes noth
   CHECK(run_command({"gather2d", "--shape", "square", "--out", (dir.path / "missing" / "x2d.hpp").string()}) != 0);
   CHECK(dir.entries().size() == 0);
 
-  // A good polygon through the same path: the header records the command with the output path as
-  // given, quoted for the shell.
-  CHECK(run_command({"gather2d", "--polygon", "0,0 1,0 1,1 0.5,0.3 0,1", "--out", out, "--trials", "2",
-                     "--height-trials", "2", "--rest-drops", "20", "--threads", "2"}) == 0);
+  // A good polygon through the same path: the header records the command quoted for the shell,
+  // the output outside the repository's tables/ by its file name, in the namespace asked for.
+  CHECK(run_command({"gather2d", "--polygon", "0,0 1,0 1,1 0.5,0.3 0,1", "--out", out, "--namespace", "game",
+                     "--trials", "2", "--height-trials", "2", "--rest-drops", "20", "--threads", "2"}) == 0);
   const std::string header = read_file(out);
-  CHECK(header.find("// command: build/bin/statsim gather2d --polygon '0,0 1,0 1,1 0.5,0.3 0,1' --out " + out +
-                    " --trials 2 --height-trials 2 --rest-drops 20\n") != std::string::npos);
+  CHECK(header.find("// command: statsim gather2d --polygon '0,0 1,0 1,1 0.5,0.3 0,1' --out bad2d.hpp "
+                    "--namespace game --trials 2 --height-trials 2 --rest-drops 20\n") != std::string::npos);
+  CHECK(header.find(dir.path.string()) == std::string::npos);
+  CHECK(header.find("\"bad2d.hpp was generated") != std::string::npos);
+  CHECK(header.find("namespace game {") != std::string::npos);
+  CHECK(header.find("inline constexpr ::statsim::Signature<2,") != std::string::npos);
   CHECK(dir.entries().size() == 1);  // no temporary file left behind
 }
 

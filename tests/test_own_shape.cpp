@@ -112,7 +112,8 @@ TEST_CASE("a mesh outside 1 cm to 10 m needs its units")
 
 TEST_CASE("mesh info and gather take the same density, and info checks units as gather does")
 {
-  CHECK(ref3d::GatherOptions{}.density == default_density);
+  const ref3d::GatherOptions defaults;
+  CHECK(defaults.density == default_density);
   std::ostringstream out, err;
   REQUIRE(mesh_info(std::string(kMeshes) + "block.stl", default_density, out, err) == 0);
   CHECK(out.str().find("density:            1000\n") != std::string::npos);

@@ -1,9 +1,12 @@
-# statsim_add_tables(TARGET name SHAPES mesh... [OPTIONS option...] [OUTPUT_DIRECTORY dir])
+# statsim_add_tables(TARGET name SHAPES mesh... [OPTIONS option...] [NAMESPACE ns]
+#                    [OUTPUT_DIRECTORY dir])
 #
 # Generates a signature table for each mesh at build time with the statsim host tool
 # (`statsim gather --mesh MESH --out .../statsim/tables/STEM.hpp OPTIONS...`) and makes an
 # INTERFACE target `name` that carries them: link it and `#include <statsim/tables/STEM.hpp>`,
-# then `world.add_shape(statsim::tables::STEM.view())`. A table is generated again only when
+# then `world.add_shape(statsim::tables::STEM.view())` (NAMESPACE: the tables are `ns::STEM`
+# instead). The header records its command with file names only, so its bytes do not depend on
+# where the mesh or the build directory are. A table is generated again only when
 # its mesh, the options or the tool change. Meshes are in metres (or say so in OPTIONS with
 # `--units` or `--scale`); relative paths are relative to the calling CMakeLists.txt. OPTIONS are
 # gather's (`statsim gather --help`): `--density`, `--precision i16`, smaller tables for tests
@@ -16,7 +19,7 @@
 # The tool is `statsim::tool`: from `find_package(statsim COMPONENTS tools)`, or the statsim
 # project itself (add_subdirectory with STATSIM_BUILD_TOOLS=ON).
 function(statsim_add_tables)
-  cmake_parse_arguments(ARG "" "TARGET;OUTPUT_DIRECTORY" "SHAPES;OPTIONS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TARGET;OUTPUT_DIRECTORY;NAMESPACE" "SHAPES;OPTIONS" ${ARGN})
   if(NOT ARG_TARGET OR NOT ARG_SHAPES)
     message(FATAL_ERROR "statsim_add_tables: give TARGET name and SHAPES mesh...")
   endif()
@@ -37,6 +40,9 @@ function(statsim_add_tables)
   endif()
   separate_arguments(extra UNIX_COMMAND "${extra}")
   list(APPEND ARG_OPTIONS ${extra})
+  if(ARG_NAMESPACE)
+    list(APPEND ARG_OPTIONS --namespace "${ARG_NAMESPACE}")
+  endif()
   # The options as a file that changes only when they do: a dependency of every table, so that
   # new options regenerate them with any generator.
   string(REPLACE ";" "\n" options_text "${ARG_OPTIONS}")

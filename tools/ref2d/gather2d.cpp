@@ -61,14 +61,6 @@ std::string hex_array(const std::vector<double>& values)
   return hex_float_array(values, ArrayStyle{6, 8, false});
 }
 
-bool is_identifier(const std::string& s)
-{
-  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) {
-    return false;
-  }
-  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
-}
-
 double angle_between(Point2 a, Point2 b)
 {
   return std::atan2(std::fabs(a.x * b.y - a.y * b.x), a.x * b.x + a.y * b.y) * 180.0 / kPi;
@@ -496,7 +488,7 @@ Shape2 gather2d_shape(const Gather2dOptions& o)
 void validate_gather2d_options(const Gather2dOptions& o)
 {
   const auto bad = [](const std::string& m) { throw std::invalid_argument(m); };
-  if (!is_identifier(o.name)) {
+  if (!cpp_identifier(o.name)) {
     bad("the table name '" + o.name + "' is not a C++ identifier (use --name)");
   }
   if (!(o.restitution >= 0.0 && o.restitution <= 1.0)) {
@@ -795,7 +787,7 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
     const double inv = 1.0 / dt;
     return std::fabs(inv - std::round(inv)) < 1e-9 * inv ? "1/" + fmt("%.0f", inv) : g6(dt);
   };
-  std::string s = table_banner("gather2d", command);
+  std::string s = table_banner("gather2d", command, o.target);
   s += "// seed " + std::to_string(o.seed) + "; reference: Box2D " + std::to_string(b2_version.major) + "." +
        std::to_string(b2_version.minor) + " (Debian libbox2d 2.4.1: polygon skin b2_polygonRadius = " +
        g6(static_cast<double>(b2_polygonRadius)) + " m, b2_linearSlop = " + g6(static_cast<double>(b2_linearSlop)) +
@@ -854,14 +846,14 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
     s += "//   packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1):" + packing_line(bc) +
          "\n";
   }
-  s += table_prologue(o.name, o.body_contacts ? 1 : 0);
+  s += table_prologue(o.name, o.body_contacts ? 1 : 0, o.target);
   s += "// Signature<D, height samples, response axes (cos theta, signed spin ratio, speed, unused), rest poses,\n"
        "//           spread values per cell (the paper's model: one standard deviation per component)>\n";
   s += table_definition("Signature<2, " + std::to_string(r.heights.size()) + ", " + std::to_string(o.cos_thetas.size()) +
                             ", " + std::to_string(o.signed_spins.size()) + ", " + std::to_string(o.speeds.size()) +
                             ", 1, " + std::to_string(kept.size()) + ", 3" +
                             (o.body_contacts ? ", " + contact_type(bc, false) : std::string()) + ">",
-                        o.name);
+                        o.name, o.target);
   statsim::Material defaults;
   const auto array = [&s](const std::string& comment, const std::vector<double>& values) {
     s += table_comment(comment) + table_entry(hex_array(values));
@@ -910,7 +902,7 @@ std::string gather2d_header(const Gather2dResult& r, const std::string& command)
   array("rest_heights, m", rh);
   array("rest_frequencies", rf);
   if (o.body_contacts) s += contact_entries(bc, false);
-  return s + table_epilogue();
+  return s + table_epilogue(o.target);
 }
 
 std::string gather2d_json(const Gather2dResult& r, const std::string& command)
@@ -1028,15 +1020,18 @@ struct Gather2dCommand {
   std::string out;
   std::string json;
   std::string name;
+  std::string name_space = "statsim::tables";
   std::vector<std::pair<std::string, CLI::Option*>> recorded;  // options written into the command line
   bool no_body_contacts = false;
   CLI::Option* shape_opt = nullptr;
   CLI::Option* polygon_opt = nullptr;
 };
 
-std::string recorded_command(const Gather2dCommand& cmd)
+// --out is written as the target records paths (a table of this repository as given, any other
+// as its file name).
+std::string recorded_command(const Gather2dCommand& cmd, const TableTarget& target)
 {
-  std::string s = "build/bin/statsim gather2d";
+  std::string s = target.program() + " gather2d";
   for (const auto& [flag, opt] : cmd.recorded) {
     if (opt->count() == 0) {
       continue;
@@ -1046,7 +1041,7 @@ std::string recorded_command(const Gather2dCommand& cmd)
       continue;
     }
     for (const std::string& value : opt->results()) {
-      s += " " + flag + " " + shell_quote(value);
+      s += " " + flag + " " + shell_quote(flag == "--out" ? target.path(value) : value);
     }
   }
   return s;
@@ -1068,12 +1063,13 @@ void run_gather2d_command(Gather2dCommand& cmd)
     const std::filesystem::path out(cmd.out);
     o.name = cmd.name.empty() ? out.stem().string() : cmd.name;
     o.body_contacts = !cmd.no_body_contacts;
+    o.target = table_target(cmd.out, cmd.name_space);
     validate_gather2d_options(o);  // fail before a long run
     const std::filesystem::path dir = out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
     if (!std::filesystem::is_directory(dir)) {
       throw std::invalid_argument("the directory of --out, '" + dir.string() + "', does not exist");
     }
-    const std::string command = recorded_command(cmd);
+    const std::string command = recorded_command(cmd, o.target);
     const auto start = std::chrono::steady_clock::now();
     const Gather2dResult r = run_gather2d(o);
     const std::string header = gather2d_header(r, command);
@@ -1108,6 +1104,8 @@ void register_gather2d_commands(CLI::App& app)
                                    "A simple polygon \"x1,y1 x2,y2 ...\" in metres (concave allowed; either orientation)");
   CLI::Option* out = g->add_option("--out", cmd->out, "Output header, e.g. tables/square2d.hpp")->required();
   CLI::Option* name = g->add_option("--name", cmd->name, "C++ name of the table (default: the file name's stem)");
+  CLI::Option* name_space =
+      g->add_option("--namespace", cmd->name_space, "C++ namespace of the table")->capture_default_str();
   CLI::Option* seed = g->add_option("--seed", o.seed, "Random seed")->capture_default_str();
   CLI::Option* trials =
       g->add_option("--trials", o.trials, "Trials per response cell")->capture_default_str()->check(CLI::Range(2, 100000));
@@ -1156,6 +1154,7 @@ void register_gather2d_commands(CLI::App& app)
                    {"--polygon", cmd->polygon_opt},
                    {"--out", out},
                    {"--name", name},
+                   {"--namespace", name_space},
                    {"--seed", seed},
                    {"--trials", trials},
                    {"--height-trials", height_trials},

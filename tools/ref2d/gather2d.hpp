@@ -17,6 +17,7 @@
 #pragma once
 
 #include "common/body_contacts.hpp"
+#include "common/table_writer.hpp"
 #include "ref2d/fig3.hpp"
 #include "ref2d/polygon2d.hpp"
 
@@ -40,6 +41,7 @@ struct Gather2dOptions {
   std::string shape = "square";  ///< "square", "lshape" or "polygon"
   std::string polygon;           ///< vertices "x1,y1 x2,y2 ..." when shape == "polygon"
   std::string name = "square2d"; ///< C++ name of the table (an identifier)
+  TableTarget target;            ///< where the header goes: how it names its paths, its namespace
   std::uint64_t seed = 1;
   double restitution = 0.3;  ///< of the body and of the ground (Box2D mixes with max: e)
   double friction = 0.5;     ///< of the body and of the ground (Box2D mixes sqrt(mu mu) = mu)

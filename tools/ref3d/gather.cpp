@@ -110,14 +110,6 @@ bool strictly_increasing(const std::vector<double>& v)
   return true;
 }
 
-bool valid_identifier(const std::string& s)
-{
-  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
-  for (char c : s)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
-  return true;
-}
-
 }  // namespace
 
 // ---- axes ------------------------------------------------------------------------------------
@@ -158,7 +150,7 @@ std::vector<double> default_coarse_speeds()
 void validate_gather_options(const GatherOptions& o)
 {
   auto fail = [](const std::string& m) { throw std::runtime_error(m); };
-  if (!o.name.empty() && !valid_identifier(o.name)) fail("--name '" + o.name + "' is not a C++ identifier");
+  if (!o.name.empty() && !cpp_identifier(o.name)) fail("--name '" + o.name + "' is not a C++ identifier");
   if (o.trials < 2) fail("--trials must be at least 2");
   if (o.height_trials < 2) fail("--height-trials must be at least 2");
   if (o.rest_drops < 1) fail("--rest-drops must be at least 1");
@@ -525,7 +517,7 @@ GatherResult gather(const GatherOptions& options)
   GatherOptions& o = r.options;
   r.model = build_model(o);
   if (o.name.empty()) o.name = r.model.name;
-  if (!valid_identifier(o.name)) throw std::runtime_error("table name '" + o.name + "' is not a C++ identifier (use --name)");
+  if (!cpp_identifier(o.name)) throw std::runtime_error("table name '" + o.name + "' is not a C++ identifier (use --name)");
   if (o.with_speed && o.speeds.empty()) o.speeds = default_paper_speeds();
   const ShapeModel& m = r.model;
   const unsigned threads = o.threads;
@@ -950,7 +942,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
   const GatherOptions& o = r.options;
   const ShapeModel& m = r.model;
   std::ostringstream h;
-  h << table_banner("gather", command);
+  h << table_banner("gather", command, o.target);
   for (const std::string& line : option_lines(r)) h << "// Options: " << line << "\n";
   for (const std::string& line : r.notes) h << "// Sized: " << line << "\n";
   h << "// Input: " << m.source;
@@ -990,7 +982,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
     contact_entries(c, o.i16, &error);
     if (o.i16) h << "// Body-body: support map i16 dequantization error " << fmt("%.3g", error) << " m\n";
   }
-  h << table_prologue(o.name, contact ? 1 : 0);
+  h << table_prologue(o.name, contact ? 1 : 0, o.target);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
                     a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
   h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
@@ -999,7 +991,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
                             std::to_string(r.rest.size()) + ", " + std::to_string(spread_size) +
                             (contact ? ", " + contact_type(c, o.i16) : std::string()) +
                             ">",
-                        o.name);
+                        o.name, o.target);
   // Short arrays on one line, long ones 8 values a line (response tables 6, one cell; normals 3).
   const auto array = [](const std::vector<double>& v, std::size_t per_line = 8) {
     return hex_float_array(v, ArrayStyle{per_line, 6, true});
@@ -1048,7 +1040,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << table_entry(array(heights));
   h << table_entry(array(freqs));
   if (contact) h << contact_entries(c, o.i16);
-  h << table_epilogue();
+  h << table_epilogue(o.target);
   return h.str();
 }
 

@@ -36,6 +36,7 @@
 #pragma once
 
 #include "common/body_contacts.hpp"
+#include "common/table_writer.hpp"
 #include "ref3d/model.hpp"
 #include "ref3d/reference.hpp"
 #include "statsim/signature.hpp"
@@ -62,6 +63,7 @@ struct GatherOptions {
   bool mesh_units_given = false;  ///< --scale or --units was given: no check of the mesh's size
   std::vector<double> box_size;  ///< non-empty: a generated box of this size (m), btBoxShape
   std::string name;           ///< table name (a C++ identifier)
+  TableTarget target;         ///< where the header goes: how it names its paths, its namespace
   bool with_speed = false;    ///< response layout: false = scaled (cos theta, cos phi, s), true = with speed
   int trials = 30;            ///< impacts per response cell
   int height_trials = 1000;   ///< flights per h_coll sample

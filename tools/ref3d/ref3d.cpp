@@ -30,9 +30,6 @@ namespace {
 
 using namespace ref3d;
 
-// The statsim command as written in generated files (run from the repository root).
-constexpr const char* kStatsim = "build/bin/statsim";
-
 std::string quote(const std::string& s)
 {
   if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./,+=:") ==
@@ -52,6 +49,7 @@ struct GatherCommand {
   std::string out;
   std::string json;
   std::string units;        ///< --units NAME (m, cm, mm, in, ft)
+  std::string name_space = "statsim::tables";  ///< --namespace
   std::string cell_report;  ///< markdown file; its JSON beside it (.json)
   std::vector<std::string> model_json;  ///< MODEL=FILE: the same gathering's JSON with another model
   bool quiet = false;
@@ -72,10 +70,12 @@ struct GatherCommand {
 };
 
 // The options that do not change the output (threads, progress, the JSON dump) are left out of
-// the recorded command, so that it is the same whatever they were.
-std::string recorded_command(const CLI::App& sub)
+// the recorded command, so that it is the same whatever they were; file paths are written as the
+// target records them (tables of this repository as given, others as file names).
+std::string recorded_command(const CLI::App& sub, const TableTarget& target)
 {
-  std::string cmd = std::string(kStatsim) + " gather";
+  static const char* const kPaths[] = {"--mesh", "--out", "--cell-report"};
+  std::string cmd = target.program() + " gather";
   for (const CLI::Option* opt : sub.get_options()) {
     const std::string name = opt->get_name(false, true);
     if (opt->count() == 0 || name.rfind("--", 0) != 0) continue;
@@ -85,8 +85,14 @@ std::string recorded_command(const CLI::App& sub)
       cmd += " " + name;
       continue;
     }
+    const bool is_path = std::find(std::begin(kPaths), std::end(kPaths), name) != std::end(kPaths);
     std::string value;
-    for (const std::string& r : opt->results()) value += (value.empty() ? "" : ",") + r;
+    for (std::string r : opt->results()) {
+      if (is_path) r = target.path(r);
+      if (name == "--model-json" && r.find('=') != std::string::npos)  // MODEL=FILE
+        r = r.substr(0, r.find('=') + 1) + target.path(r.substr(r.find('=') + 1));
+      value += (value.empty() ? "" : ",") + r;
+    }
     cmd += " " + name + " " + quote(value);
   }
   return cmd;
@@ -213,6 +219,7 @@ void run(const GatherCommand& c, const CLI::App& sub)
       return;
     }
     if (c.out.empty()) throw std::runtime_error("--out FILE is required");
+    o.target = table_target(c.out, c.name_space);
     // Fail before the long run, not after it.
     auto parent = [](const std::string& f) {
       const std::filesystem::path p = std::filesystem::path(f).parent_path();
@@ -241,10 +248,11 @@ void run(const GatherCommand& c, const CLI::App& sub)
       model_json.emplace_back(other, mj.substr(eq + 1));
       ensure_writable_directory(parent(model_json.back().second));
     }
-    const std::string command = recorded_command(sub);
+    const std::string command = recorded_command(sub, o.target);
     GatherResult r;
     if (c.size_for_scene) r = gather_sized(c, o, out);
     else r = gather(o);
+    r.model.source = o.target.path(r.model.source);
     const std::string header = header_text(r, command);
     // The runtime's own checks on the numbers written (its add_shape on the same table read
     // back from JSON): a table it would refuse is never written.
@@ -353,6 +361,7 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
                   "(K: its --empirical-outcomes; the precision) (repeatable; for comparing models on the same trials)");
   sub->add_option("--threads", o.threads, "Worker threads (0 = all hardware threads)")->capture_default_str();
   sub->add_option("--name", o.name, "Table name (default: the shape's name)");
+  sub->add_option("--namespace", c->name_space, "C++ namespace of the table")->capture_default_str();
   sub->add_option("--speed", o.speed, "|V-| of the impacts of the scaled layout, m/s")->capture_default_str();
   sub->add_option("--speeds", o.speeds, "Speed axis of --layout paper, m/s (comma-separated)")->delimiter(',');
   // A table axis: comma-separated samples, the default shown in --help.
@@ -480,7 +489,7 @@ void add_gather_pairs(CLI::App& app)
     try {
       PairOptions opts = c->o;
       opts.shape.progress = !c->quiet;
-      std::string cmd = std::string(kStatsim) + " gather-pairs";
+      std::string cmd = "build/bin/statsim gather-pairs";  // as run from the repository root
       for (const CLI::Option* opt : sub->get_options()) {
         const std::string name = opt->get_name(false, true);
         if (opt->count() == 0 || name.rfind("--", 0) != 0 || name == "--threads" || name == "--quiet" ||
