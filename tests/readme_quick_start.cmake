@@ -1,5 +1,6 @@
-# README.md's quick start for a user's own mesh, exactly as written: the two files and the three
-# commands of "Your own mesh" are extracted from the README (each fenced block follows a
+# README.md's quick start for a user's own mesh, exactly as written: the two files and the
+# commands of "Your own mesh" (after the set-up command, which built the build under test) are
+# extracted from the README (each fenced block follows a
 # "<!-- quick start: NAME -->" line) and run in a scratch directory, with the test mesh
 # tests/meshes/block.stl as my_app/part.stl, HOME set to the scratch directory, and `build` the
 # build directory under test. Run by CTest (test readme_quick_start).
@@ -34,7 +35,8 @@ extract("my_app/CMakeLists.txt" cmake_text)
 extract("my_app/main.cpp" cpp_text)
 extract("commands" commands_text)
 
-# The goal: at most 30 lines of code and three commands.
+# The goal: at most 30 lines of code and three commands from a fresh clone, the first of them
+# README's set-up command.
 string(REGEX MATCHALL "\n" cmake_lines "${cmake_text}")
 string(REGEX MATCHALL "\n" cpp_lines "${cpp_text}")
 list(LENGTH cmake_lines n_cmake)
@@ -44,8 +46,8 @@ string(REGEX REPLACE "\n$" "" commands_text "${commands_text}")
 string(REPLACE "\n" ";" commands "${commands_text}")
 list(LENGTH commands n_commands)
 message(STATUS "quick start: ${n_code} lines of code, ${n_commands} commands")
-if(n_code GREATER 30 OR NOT n_commands EQUAL 3)
-  message(FATAL_ERROR "the quick start must stay within 30 lines of code and 3 commands")
+if(n_code GREATER 30 OR n_commands GREATER 2)
+  message(FATAL_ERROR "the quick start must stay within 30 lines of code and 3 commands (the set-up command and 2)")
 endif()
 
 file(REMOVE_RECURSE "${WORK_DIR}")
