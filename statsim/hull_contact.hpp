@@ -286,6 +286,86 @@ bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, boo
   return true;
 }
 
+/// Tangent axes of a contact plane of unit normal `n`: in 3D the direction of the tangent `x`
+/// (any perpendicular of n when |x| <= `tiny`: the smallest component of n crossed out) and
+/// n x that; in 2D the plane's one direction.
+inline void contact_axes(const Vector3& n, const Vector3& x, Scalar tiny, Vector3 (&axes)[2])
+{
+  const Scalar xn = x.norm();
+  if (xn > tiny) {
+    axes[0] = x / xn;
+  } else {
+    const Vector3 ax = n.cwiseAbs();
+    const int k = ax.x() <= ax.y() ? (ax.x() <= ax.z() ? 0 : 2) : (ax.y() <= ax.z() ? 1 : 2);
+    axes[0] = n.cross(Vector3::Unit(k)).normalized();
+  }
+  axes[1] = n.cross(axes[0]);
+}
+inline void contact_axes(const Vector2& n, const Vector2&, Scalar, Vector2 (&axes)[1]) { axes[0] = Vector2(-n.y(), n.x()); }
+
+/// How far a body's support extends from its centre across a contact: the one-sided
+/// derivative of the support function at body direction `n` toward the tangent `a`,
+/// (s(n + h a) - s(n)) / h, with `s0` = s(n) and h one cell of the support map. For a convex
+/// hull s is convex along n + h a, so the quotient grows with h from the extent of the support
+/// set (the face or edge that touches) toward s(a); over one cell it is the face's extent where
+/// the map's creases lie on its grid (a cube's exactly), and never less. 0 for a plain sphere,
+/// whose support set is the point under its centre.
+template <int D>
+Scalar support_extent(const Shape<D>& s, const typename Space<D>::Vec& n, const typename Space<D>::Vec& a, Scalar s0)
+{
+  if (!s.statistical) return 0;
+  const ContactView<D>& c = s.signature.contact;
+  const Scalar h = Scalar(2) / Scalar(c.support_size - 1);
+  return (support_along(c, typename Space<D>::Vec(n + a * h)) - s0) / h;
+}
+
+/// Where a body `up` resting on a body `lo` along the unit normal `n` (from lo to up) is held:
+/// `pivot`, the point of the contact region nearest to where the line of gravity through up's
+/// centre meets the contact plane, and `overhang`, from the pivot to that point (zero when the
+/// region holds the centre of mass). The contact plane is lo's support plane along n; the region
+/// is, along the tangent u toward the centre's line of gravity and (3D) along w = n x u, the
+/// overlap of lo's support set, [-e_lo(-u), e_lo(u)] about lo's centre, and up's support set
+/// along -n, [-e_up(-u), e_up(u)] about up's centre (`support_extent`): a box about the two
+/// support sets' common part. False when gravity does not press up onto lo.
+template <int D>
+bool support_overhang(const Shape<D>& slo, const Body<D>& lo, const Shape<D>& sup, const Body<D>& up,
+                      const typename Space<D>::Vec& n, const typename Space<D>::Vec& gravity_unit,
+                      typename Space<D>::Vec& pivot, typename Space<D>::Vec& overhang)
+{
+  using Vec = typename Space<D>::Vec;
+  const Scalar press = -gravity_unit.dot(n);
+  if (!(press > 0)) return false;
+  const Vec d = up.position - lo.position;
+  const Vec n_lo = to_body(lo.orientation, n), n_up = to_body(up.orientation, Vec(-n));
+  const Scalar s_lo = shape_support(slo, n_lo), s_up = shape_support(sup, n_up);
+  // The line of gravity through up's centre meets lo's support plane, n.x = n.c_lo + s_lo, at
+  // x = c_up + g^ t with t = (d.n - s_lo) / (-g^.n): relative to lo's centre, x - c_lo - n s_lo
+  // lies in the plane.
+  const Scalar above = d.dot(n) - s_lo;
+  const Vec x = d + gravity_unit * (above / press) - n * s_lo;
+  // Up's centre projected along n onto the plane, relative to lo's centre.
+  const Vec c = d - n * d.dot(n);
+  Vec axes[D == 3 ? 2 : 1];
+  contact_axes(n, x, Scalar(1e-6) * up.bounding_radius, axes);
+  pivot = lo.position + n * s_lo;
+  overhang = Vec::Zero();
+  for (const Vec& a : axes) {
+    const Vec a_lo = to_body(lo.orientation, a), a_up = to_body(up.orientation, a);
+    const Scalar ca = c.dot(a), xa = x.dot(a);
+    const Scalar lo_hi = support_extent(slo, n_lo, a_lo, s_lo), lo_lo = -support_extent(slo, n_lo, Vec(-a_lo), s_lo);
+    const Scalar up_hi = ca + support_extent(sup, n_up, a_up, s_up);
+    const Scalar up_lo = ca - support_extent(sup, n_up, Vec(-a_up), s_up);
+    Scalar from = lo_lo > up_lo ? lo_lo : up_lo, to = lo_hi < up_hi ? lo_hi : up_hi;
+    // Sets that meet at a point (an edge on a face, a corner on an edge) come out a little apart
+    // or overlapping from the interpolated map: apart, they meet halfway.
+    if (from > to) from = to = Scalar(0.5) * (from + to);
+    const Scalar held = xa < from ? from : (xa > to ? to : xa);
+    pivot += a * held;
+    overhang += a * (xa - held);
+  }
+  return true;
+}
+
 /// The radius a body keeps from a plane of normal `n`: its collision radius, or, for a
 /// settling body with a hull (`BodyContacts::hulls`), at least its hull's support toward the
 /// plane, so that a body resting out of its rest poses (propped by others) does not sink its

@@ -236,6 +236,11 @@ struct Body {
   bool on_ground;                         ///< touched a near-horizontal plane in the last step
   std::uint8_t rest_pose;                 ///< chosen rest pose, or `no_rest_pose`
   bool pile_rest;                         ///< settling on other bodies, blending to the mean h_rest (`WorldDef::pile_rest`)
+  /// With hull contacts, the horizontal directions (eight sectors, one bit each) from which
+  /// bodies and planes held the body in the step's shock pass, all bits when one held it under
+  /// its centre of mass (`detail::mark_supports`); scratch of the step, not part of the state,
+  /// valid only for bodies of its touching pairs.
+  std::uint8_t supports;
 };
 
 /// `Body::rest_pose` when no rest pose is chosen.

@@ -157,3 +157,67 @@ TEST_CASE("hull contacts: a 2D pile of squares and L-shapes ends asleep, above t
   CHECK(asleep + 3 >= w->body_count());
   CHECK(overlap < Scalar(0.2));
 }
+
+TEST_CASE("hull contacts: a body whose centre lies beyond the edge of the one below tips off and rests on the ground")
+{
+  // The lower body sleeps (a fixed support); the upper one is placed touching it, at rest, its
+  // centre a quarter of a side in from the edge (it stays) or half a side beyond it (it falls).
+  for (const Scalar overhang : {Scalar(-0.25), Scalar(0.25)}) {
+    CAPTURE(overhang);
+    WorldDef3 def;
+    def.body_contacts = BodyContacts::hulls;
+    auto w = std::make_unique<World3<4>>(def);
+    const ShapeId box = w->add_shape(tables::box.view()).id;  // a cube of side 0.2 m
+    REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).status == Status::ok);
+    BodyDef3 b;
+    b.shape = box;
+    b.mass = 8;
+    b.position = Vector3(0, 0, Scalar(0.1));
+    b.asleep = true;
+    REQUIRE(w->add_body(b).status == Status::ok);
+    b.asleep = false;
+    b.position = Vector3(Scalar(0.1) + Scalar(0.2) * overhang, Scalar(0.03), Scalar(0.3));
+    REQUIRE(w->add_body(b).status == Status::ok);
+    for (int s = 0; s < 300; ++s) REQUIRE(w->step(Scalar(1) / 60).ok());
+    const auto& top = w->body(1);
+    CHECK(top.state == MotionState::asleep);
+    if (overhang < 0) {
+      CHECK(top.position.z() > Scalar(0.29));
+      CHECK(std::fabs(top.position.x() - Scalar(0.05)) < Scalar(1e-3));
+    } else {
+      CHECK(top.position.z() < Scalar(0.11));  // on the ground, on a face
+      CHECK(top.position.x() > Scalar(0.2));   // beside the lower cube
+    }
+  }
+}
+
+TEST_CASE("hull contacts: 2D, a square whose centre lies beyond the edge of the one below tips off and rests on the ground")
+{
+  for (const Scalar overhang : {Scalar(-0.25), Scalar(0.25)}) {
+    CAPTURE(overhang);
+    WorldDef2 def;
+    def.body_contacts = BodyContacts::hulls;
+    auto w = std::make_unique<World2<4>>(def);
+    const ShapeId square = w->add_shape(tables::square2d.view()).id;  // side 1 m
+    REQUIRE(w->add_plane(Vector2(0, 1), 0).status == Status::ok);
+    BodyDef2 b;
+    b.shape = square;
+    b.mass = 1;
+    b.position = Vector2(0, Scalar(0.5));
+    b.asleep = true;
+    REQUIRE(w->add_body(b).status == Status::ok);
+    b.asleep = false;
+    b.position = Vector2(Scalar(0.5) + overhang, Scalar(1.5));
+    REQUIRE(w->add_body(b).status == Status::ok);
+    for (int s = 0; s < 300; ++s) REQUIRE(w->step(Scalar(1) / 60).ok());
+    const auto& top = w->body(1);
+    CHECK(top.state == MotionState::asleep);
+    if (overhang < 0) {
+      CHECK(top.position.y() > Scalar(1.45));
+      CHECK(std::fabs(top.position.x() - Scalar(0.25)) < Scalar(5e-3));
+    } else {
+      CHECK(top.position.y() < Scalar(0.55));
+      CHECK(top.position.x() > Scalar(1));
+    }
+  }
+}
