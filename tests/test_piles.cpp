@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 using namespace statsim::tools::scenes;
@@ -123,6 +124,31 @@ TEST_CASE("piles: the bin is deterministic, its bodies apart and inside the wall
     // Every plane: the bounding sphere on the inner side.
     for (const ScenePlane& p : a.planes) CHECK(p.normal.dot(b.position) - p.offset >= o.bounding_radius);
   }
+}
+
+TEST_CASE("piles: a mixed heap or bin takes two shapes in turn, its bodies those of the one-shape scene")
+{
+  BinOptions o;
+  o.count = 45;
+  o.bounding_radius = 0.1;
+  const PileScene3 one = bin_scene(o);
+  CHECK(one.shapes.empty());
+  o.shapes = 2;
+  const PileScene3 two = bin_scene(o);
+  CHECK(same(one.bodies, two.bodies));
+  REQUIRE(two.shapes.size() == 45);
+  for (std::size_t i = 0; i < two.shapes.size(); ++i) CHECK(two.shapes[i] == int(i % 2));
+  HeapOptions h;
+  h.count = 7;
+  h.shapes = 2;
+  const PileScene3 heap = heap_scene(h);
+  REQUIRE(heap.shapes.size() == 7);
+  CHECK(heap.shapes[6] == 0);
+  CHECK(heap.shapes[5] == 1);
+  o.shapes = 3;
+  CHECK_THROWS_AS(bin_scene(o), std::invalid_argument);
+  h.shapes = 0;
+  CHECK_THROWS_AS(heap_scene(h), std::invalid_argument);
 }
 
 TEST_CASE("piles: a column and a wall of cubes touch exactly, face to face")

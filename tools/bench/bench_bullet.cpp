@@ -113,18 +113,23 @@ namespace {
 
 class BulletSim final : public Sim {
 public:
-  BulletSim(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
-            const bullet::DropSettings& settings, const std::vector<scenes::BodyState3>& states, double dt)
-      : shapes_(shapes), method_(method), dt_(dt)
+  BulletSim(const std::vector<std::shared_ptr<BulletShapes>>& shapes, const std::vector<int>& of_body,
+            const std::string& method, const bullet::DropSettings& settings,
+            const std::vector<scenes::BodyState3>& states, double dt)
+      : shapes_(shapes), of_body_(of_body), method_(method), dt_(dt)
   {
-    const Body3& body = shapes->body();
-    bullet::DropBody b;
-    b.shape = shapes->shape(method);
-    if (!b.shape) throw std::runtime_error("Bullet: no shape for method " + method);
-    b.mass = body.mass;
-    b.inertia = body.inertia;
-    b.bounding_radius = body.bounding_radius;
-    world_ = std::make_unique<bullet::DropWorld>(b, states, settings);
+    std::vector<bullet::DropBody> kinds;
+    for (const std::shared_ptr<BulletShapes>& sh : shapes) {
+      const Body3& body = sh->body();
+      bullet::DropBody b;
+      b.shape = sh->shape(method);
+      if (!b.shape) throw std::runtime_error("Bullet: no shape for method " + method + " of " + body.shape);
+      b.mass = body.mass;
+      b.inertia = body.inertia;
+      b.bounding_radius = body.bounding_radius;
+      kinds.push_back(b);
+    }
+    world_ = std::make_unique<bullet::DropWorld>(kinds, of_body, states, settings);
   }
 
   void step() override { world_->step(dt_); }
@@ -146,9 +151,9 @@ public:
   }
   double kinetic_energy() const override
   {
-    const Body3& body = shapes_->body();
     double ke = 0;
     for (std::size_t i = 0; i < world_->size(); ++i) {
+      const Body3& body = body_of(i);
       const scenes::BodyState3 s = world_->state(i);
       const Eigen::Vector3d wb = s.orientation.conjugate() * s.angular_velocity;
       ke += 0.5 * body.mass * s.linear_velocity.squaredNorm() + 0.5 * wb.dot(body.inertia.cwiseProduct(wb));
@@ -159,11 +164,17 @@ public:
   double lowest(std::size_t i) const override
   {
     const scenes::BodyState3 s = world_->state(i);
-    return s.position.z() + lowest_offset(shapes_->body(), method_, s.orientation);
+    return s.position.z() + lowest_offset(body_of(i), method_, s.orientation);
   }
 
 private:
-  std::shared_ptr<BulletShapes> shapes_;  // outlives the world, which points to its shapes
+  const Body3& body_of(std::size_t i) const
+  {
+    return shapes_[of_body_.empty() ? 0 : static_cast<std::size_t>(of_body_[i])]->body();
+  }
+
+  std::vector<std::shared_ptr<BulletShapes>> shapes_;  // outlive the world, which points to their shapes
+  std::vector<int> of_body_;
   std::string method_;
   double dt_;
   std::unique_ptr<bullet::DropWorld> world_;
@@ -227,7 +238,16 @@ std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, co
                                  const bullet::DropSettings& settings, const std::vector<scenes::BodyState3>& states,
                                  double dt)
 {
-  return std::make_unique<BulletSim>(shapes, method, settings, states, dt);
+  return std::make_unique<BulletSim>(std::vector<std::shared_ptr<BulletShapes>>{shapes}, std::vector<int>{}, method,
+                                     settings, states, dt);
+}
+
+std::unique_ptr<Sim> make_bullet_mixed(const std::vector<std::shared_ptr<BulletShapes>>& shapes,
+                                       const std::vector<int>& of_body, const std::string& method,
+                                       const bullet::DropSettings& settings,
+                                       const std::vector<scenes::BodyState3>& states, double dt)
+{
+  return std::make_unique<BulletSim>(shapes, of_body, method, settings, states, dt);
 }
 
 std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,

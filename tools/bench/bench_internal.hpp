@@ -179,6 +179,12 @@ struct StatsimVariant {
 std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mass, const scenes::DropScene3& scene,
                                          std::uint64_t seed, double dt, const std::string& broad_phase,
                                          const StatsimVariant& variant, const std::vector<bullet::Plane>& walls = {});
+/// A statsim world of one or two shapes (a mixed pile): body i of shape `of_body[i]` (an index
+/// into `sigs` and `masses`, kg; all the first when empty), the runtime's default broad phase.
+std::unique_ptr<Sim> make_statsim3_mixed(const std::vector<SignatureView<3>>& sigs, const std::vector<double>& masses,
+                                          const std::vector<int>& of_body, const scenes::DropScene3& scene,
+                                          std::uint64_t seed, double dt, const StatsimVariant& variant,
+                                          const std::vector<bullet::Plane>& walls = {});
 /// `broad_phase`: "" = the runtime's default, "grid" or "sap" (sweep-and-prune).
 std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
                                    const std::string& broad_phase);
@@ -202,6 +208,12 @@ std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, co
 std::unique_ptr<Sim> make_bullet(const std::shared_ptr<BulletShapes>& shapes, const std::string& method,
                                  const bullet::DropSettings& settings, const std::vector<scenes::BodyState3>& states,
                                  double dt);
+/// A Bullet world of several shapes (a mixed pile): body i of `shapes[of_body[i]]` (all the first
+/// when empty), each with its own mass properties, the settings of the first.
+std::unique_ptr<Sim> make_bullet_mixed(const std::vector<std::shared_ptr<BulletShapes>>& shapes,
+                                              const std::vector<int>& of_body, const std::string& method,
+                                              const bullet::DropSettings& settings,
+                                              const std::vector<scenes::BodyState3>& states, double dt);
 /// Lowest point of `method`'s representation of the body below its centre for orientation q, m:
 /// the minimum over its geometry of (R p).z (negative).
 double lowest_offset(const Body3& body, const std::string& method, const Eigen::Quaterniond& q);

@@ -82,15 +82,24 @@ void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::Bod
   if (!added.ok()) throw std::runtime_error(std::string("statsim add_body: ") + to_string(added.status));
 }
 
+/// The shapes of a world: signature and mass of each, and the shape of each body (all the first
+/// when `of_body` is empty).
+template <int D>
+struct ShapeSet {
+  std::vector<SignatureView<D>> sigs;
+  std::vector<double> masses;
+  std::vector<int> of_body;
+};
+
 /// A statsim world of capacity `Cap` with the scene's bodies and the ground.
 template <int D, std::uint32_t Cap>
 class StatsimSim final : public Sim {
 public:
-  // Planes: the ground and up to 7 more (the bin scene's four walls).
+  // Planes: the ground and up to 7 more (the bin scene's four walls). Shapes: up to 2.
   using WorldT = World<D, Cap, 8, Cap * kPairsPerBody, 2>;
 
   template <class Scene>
-  StatsimSim(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed, double dt,
+  StatsimSim(const ShapeSet<D>& set, const Scene& scene, std::uint64_t seed, double dt,
              const std::string& broad_phase, const StatsimVariant& variant = {},
              const std::vector<bullet::Plane>& walls = {})
       : dt_(static_cast<Scalar>(dt))
@@ -106,15 +115,25 @@ public:
     world_ = std::make_unique<WorldT>(def);
     if (world_->construction_status() != Status::ok)
       throw std::runtime_error(std::string("statsim world: ") + to_string(world_->construction_status()));
-    const Added<ShapeId> shape = world_->add_shape(sig);
-    if (!shape.ok()) throw std::runtime_error(std::string("statsim add_shape: ") + to_string(shape.status));
+    std::vector<ShapeId> ids;
+    for (const SignatureView<D>& sig : set.sigs) {
+      const Added<ShapeId> shape = world_->add_shape(sig);
+      if (!shape.ok()) throw std::runtime_error(std::string("statsim add_shape: ") + to_string(shape.status));
+      ids.push_back(shape.id);
+    }
     if (!world_->add_plane(Space<D>::Vec::Unit(Space<D>::up_axis), 0).ok())
       throw std::runtime_error("statsim add_plane failed");
     if constexpr (D == 3)
       for (const bullet::Plane& p : walls)
         if (!world_->add_plane(p.normal.cast<Scalar>(), static_cast<Scalar>(p.offset)).ok())
           throw std::runtime_error("statsim add_plane (wall) failed");
-    for (const auto& s : scene.bodies) add_body<D>(*world_, shape.id, mass, s);
+    if (!set.of_body.empty() && set.of_body.size() != scene.bodies.size())
+      throw std::runtime_error("statsim world: one shape index per body");
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+      const std::size_t k = set.of_body.empty() ? 0 : static_cast<std::size_t>(set.of_body[i]);
+      if (k >= ids.size()) throw std::runtime_error("statsim world: shape index out of range");
+      add_body<D>(*world_, ids[k], set.masses[k], scene.bodies[i]);
+    }
   }
   void step() override
   {
@@ -179,17 +198,17 @@ private:
 };
 
 template <int D, class Scene>
-std::unique_ptr<Sim> make_sized(const SignatureView<D>& sig, double mass, const Scene& scene, std::uint64_t seed,
-                                double dt, const std::string& broad_phase, const StatsimVariant& v = {},
+std::unique_ptr<Sim> make_sized(const ShapeSet<D>& sig, const Scene& scene, std::uint64_t seed, double dt,
+                                const std::string& broad_phase, const StatsimVariant& v = {},
                                 const std::vector<bullet::Plane>& w = {})
 {
   const std::size_t n = scene.bodies.size();
-  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, mass, scene, seed, dt, broad_phase, v, w);
-  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, mass, scene, seed, dt, broad_phase, v, w);
-  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, mass, scene, seed, dt, broad_phase, v, w);
-  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, mass, scene, seed, dt, broad_phase, v, w);
-  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, mass, scene, seed, dt, broad_phase, v, w);
-  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, mass, scene, seed, dt, broad_phase, v, w);
+  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, scene, seed, dt, broad_phase, v, w);
   throw std::runtime_error("statsim bench worlds hold at most " + std::to_string(kCapacity) + " bodies");
 }
 
@@ -237,7 +256,7 @@ std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& 
 {
   const std::optional<SignatureView<3>> t = table3(body.shape);
   if (!t) throw std::runtime_error("no statistical table for " + body.shape);
-  return make_sized<3>(*t, body.mass, scene, seed, dt, broad_phase);
+  return make_sized<3>(ShapeSet<3>{{*t}, {body.mass}, {}}, scene, seed, dt, broad_phase);
 }
 
 bool statsim_table3(const std::string& shape, SignatureView<3>& out)
@@ -252,13 +271,23 @@ std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mas
                                          std::uint64_t seed, double dt, const std::string& broad_phase,
                                          const StatsimVariant& variant, const std::vector<bullet::Plane>& walls)
 {
-  return make_sized<3>(sig, mass, scene, seed, dt, broad_phase, variant, walls);
+  return make_sized<3>(ShapeSet<3>{{sig}, {mass}, {}}, scene, seed, dt, broad_phase, variant, walls);
+}
+
+std::unique_ptr<Sim> make_statsim3_mixed(const std::vector<SignatureView<3>>& sigs, const std::vector<double>& masses,
+                                          const std::vector<int>& of_body, const scenes::DropScene3& scene,
+                                          std::uint64_t seed, double dt, const StatsimVariant& variant,
+                                          const std::vector<bullet::Plane>& walls)
+{
+  if (sigs.empty() || sigs.size() > 2 || masses.size() != sigs.size())
+    throw std::runtime_error("statsim world: one or two shapes, one mass each");
+  return make_sized<3>(ShapeSet<3>{sigs, masses, of_body}, scene, seed, dt, "", variant, walls);
 }
 
 std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,
                                    const std::string& broad_phase)
 {
-  return make_sized<2>(tables::square2d.view(), body.mass, scene, seed, dt, broad_phase);
+  return make_sized<2>(ShapeSet<2>{{tables::square2d.view()}, {body.mass}, {}}, scene, seed, dt, broad_phase);
 }
 
 }  // namespace statsim::tools::bench

@@ -158,9 +158,22 @@ struct DropWorld::Impl {
 
 DropWorld::DropWorld(const DropBody& body, const std::vector<scenes::BodyState3>& states,
                      const DropSettings& settings)
+    : DropWorld(std::vector<DropBody>{body}, std::vector<int>{}, states, settings)
+{
+}
+
+DropWorld::DropWorld(const std::vector<DropBody>& bodies, const std::vector<int>& of_body,
+                     const std::vector<scenes::BodyState3>& states, const DropSettings& settings)
     : impl_(std::make_unique<Impl>())
 {
-  if (!body.shape) throw std::invalid_argument("Bullet drop world: no collision shape");
+  if (bodies.empty()) throw std::invalid_argument("Bullet drop world: no body");
+  for (const DropBody& body : bodies)
+    if (!body.shape) throw std::invalid_argument("Bullet drop world: no collision shape");
+  if (!of_body.empty() && of_body.size() != states.size())
+    throw std::invalid_argument("Bullet drop world: one shape index per body");
+  for (int k : of_body)
+    if (k < 0 || static_cast<std::size_t>(k) >= bodies.size())
+      throw std::invalid_argument("Bullet drop world: shape index out of range");
   Impl& m = *impl_;
   const int n = static_cast<int>(states.size());
   btDefaultCollisionConstructionInfo cci;
@@ -191,7 +204,9 @@ DropWorld::DropWorld(const DropBody& body, const std::vector<scenes::BodyState3>
                              ? settings.rolling_resistance * settings.rolling_radius / friction
                              : 0.0;
   m.bodies.reserve(states.size());
-  for (const scenes::BodyState3& s : states) {
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const scenes::BodyState3& s = states[i];
+    const DropBody& body = bodies[of_body.empty() ? 0 : static_cast<std::size_t>(of_body[i])];
     btRigidBody::btRigidBodyConstructionInfo info(body.mass, nullptr, body.shape, to_bt(body.inertia));
     info.m_friction = friction;
     info.m_restitution = restitution;

@@ -103,6 +103,10 @@ struct DropBody {
 class DropWorld {
 public:
   DropWorld(const DropBody& body, const std::vector<scenes::BodyState3>& states, const DropSettings& settings);
+  /// Bodies of several shapes: body i is `bodies[of_body[i]]` (all the first when `of_body` is
+  /// empty). Throws std::invalid_argument on an index out of range.
+  DropWorld(const std::vector<DropBody>& bodies, const std::vector<int>& of_body,
+            const std::vector<scenes::BodyState3>& states, const DropSettings& settings);
   ~DropWorld();
   DropWorld(const DropWorld&) = delete;
   DropWorld& operator=(const DropWorld&) = delete;

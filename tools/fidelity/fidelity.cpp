@@ -196,13 +196,15 @@ const char* scenes_definitions()
          "until every body rests (asleep, or slower than 0.01 m/s for 0.5 s) or --time-limit (the heap: after its last "
          "release). column, wall: "
          "--column-height bodies, or --wall-columns columns of --wall-height, in a rest pose (the first box's "
-         "faces along the world axes), touching, no velocity; measured after --stack-time s.\n"
+         "faces along the world axes), touching, no velocity; measured after --stack-time s. --mix SHAPE: heap and "
+         "bin of two shapes, body i of --shape when i is even and of SHAPE when odd, R the larger bounding radius, "
+         "each statsim body with its own shape's table and Bullet body with its own mesh.\n"
          "angle_deg: 8 angular sectors and radial bins of width R about the centres' mean (x, y); each cell's top is "
          "its highest centre; least squares z = a + b r over the tops of every sector from its highest cell outward, "
          "up to its first empty cell or first top less than R/2 above the lowest centre; atan(-b) in degrees (0 with "
          "fewer than 2 tops). height: "
          "the highest centre, m. fill_height: twice the mean centre height, m. packing: N V / (A fill_height), V the "
-         "mesh's volume, A the bin's floor area. held: the highest centre's height over the highest placed centre's "
+         "mesh's volume (mixed: the bodies' mean), A the bin's floor area. held: the highest centre's height over the highest placed centre's "
          "(1: the true height). overlap: deepest penetration between boxes of different bodies (separating axis "
          "test on the shape's boxes) or of a box corner below the ground, mm. all asleep: share of runs with every body asleep at the end (the engine's "
          "sleep state; Bullet: deactivated).\n"
@@ -438,6 +440,13 @@ void validate(const FidelityOptions& o)
   if (!o.mesh.empty() && o.tables.empty()) bad("--mesh needs --table NAME=FILE.json (the shape has no compiled table)");
   for (const auto& t : o.tables)
     if (t.first.empty() || t.second.empty()) bad("--table takes NAME=FILE.json");
+  if (!o.mix.empty()) {
+    if (o.mix != "bunny" && o.mix != "box" && o.mix != "lshape") bad("--mix takes bunny, box or lshape");
+    if (!o.mesh.empty() || !o.tables.empty()) bad("--mix needs a compiled shape (no --mesh, no --table)");
+    if (o.drops) bad("--mix needs --scenes-only (it mixes the heap and the bin)");
+    for (const std::string& k : o.scenes)
+      if (k != "heap" && k != "bin") bad("--mix takes the heap and bin scenes only (got '" + k + "')");
+  }
 }
 
 // ---- running -------------------------------------------------------------------------------------
@@ -458,6 +467,11 @@ struct MethodSpec {
 
 struct Setup {
   bench::Body3 body;
+  // --mix: the second shape of the mixed scenes and its compiled table (every statistical method
+  // takes it for that shape's bodies).
+  bench::Body3 mix_body;
+  SignatureView<3> mix_table{};
+  bool mixed = false;
   SignatureView<3> poses;  // the signature whose rest poses classify every run
   std::vector<LoadedSignature3> loaded;
   std::vector<MethodSpec> methods;
@@ -804,6 +818,11 @@ Setup make_setup(const FidelityOptions& o)
     s.body = body_from_mesh(o.mesh, s.loaded.front().view());
   }
   s.radius = s.body.bounding_radius;
+  if (!o.mix.empty()) {
+    s.mixed = true;
+    s.mix_body = bench::load_body3(o.mix, o.meshes_dir);
+    if (!bench::statsim_table3(o.mix, s.mix_table)) throw std::runtime_error("no statistical table for " + o.mix);
+  }
   const std::vector<std::string> names = o.methods.empty() ? default_methods() : o.methods;
   if (o.reference == "gather" || std::find(names.begin(), names.end(), "full-gather") != names.end()) {
     // The gathering's defaults (tables/NAME.hpp's header lists them) at the body's density.
@@ -819,12 +838,17 @@ Setup make_setup(const FidelityOptions& o)
   const std::string base_name = have_compiled ? s.body.table_name : s.loaded.front().path;
 
   auto shapes = bench::make_bullet_shapes(s.body);
+  auto mix_shapes = s.mixed ? bench::make_bullet_shapes(s.mix_body) : nullptr;
   for (const std::string& name : names) {
     MethodSpec m;
     m.name = name;
+    if (s.mixed && name.rfind("statistical:", 0) == 0) {
+      if (o.methods.empty()) continue;
+      throw std::invalid_argument("method " + name + ": --mix takes the compiled tables only");
+    }
     if (name == "full" || name == "low" || name == "hull" || name == "spheres7" || name == "sphere") {
       std::string why;
-      if (!bench::bullet_supports(*shapes, name, why)) {
+      if (!bench::bullet_supports(*shapes, name, why) || (mix_shapes && !bench::bullet_supports(*mix_shapes, name, why))) {
         if (o.methods.empty()) continue;  // the default list keeps what the shape supports
         throw std::invalid_argument("method " + name + ": " + why);
       }
@@ -940,21 +964,29 @@ double mesh_volume(const bench::Body3& body)
   return std::fabs(v) / 6.0;
 }
 
+// The bounding radius R of the heap and bin: of the shape, or the larger of a mixed scene's two.
+double scene_radius(const Setup& setup)
+{
+  return setup.mixed ? std::max(setup.radius, setup.mix_body.bounding_radius) : setup.radius;
+}
+
 scenes::PileScene3 make_scene(const Setup& setup, const FidelityOptions& o, const std::string& kind,
                               std::uint64_t seed)
 {
   if (kind == "heap") {
     scenes::HeapOptions h;
     h.count = o.heap_count;
-    h.bounding_radius = setup.radius;
+    h.bounding_radius = scene_radius(setup);
     h.seed = seed;
+    h.shapes = setup.mixed ? 2 : 1;
     return scenes::heap_scene(h);
   }
   if (kind == "bin") {
     scenes::BinOptions b;
     b.count = o.bin_count;
-    b.bounding_radius = setup.radius;
+    b.bounding_radius = scene_radius(setup);
     b.seed = seed;
+    b.shapes = setup.mixed ? 2 : 1;
     b.cells = o.bin_cells;
     return scenes::bin_scene(b);
   }
@@ -994,11 +1026,14 @@ struct SceneOutcome {
   SceneRun run;
   std::vector<scenes::BodyState3> states;  // final
   std::vector<bool> asleep;
+  std::vector<int> shapes;  // a mixed scene's shape of each body (PileScene3::shapes)
 };
 
 SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::PileScene3& sc,
-                       const FidelityOptions& o, double dt, std::uint64_t world_seed, double volume)
+                       const FidelityOptions& o, double dt, std::uint64_t world_seed,
+                       const std::vector<double>& volumes)
 {
+  const double radius = scene_radius(setup);
   const scenes::DropScene3 drop = sc.as_drop_scene();
   std::vector<bullet::Plane> planes;
   for (const scenes::ScenePlane& p : sc.planes) planes.push_back({p.normal, p.offset});
@@ -1007,11 +1042,19 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
     // dbvt: the sweep-and-prune broad phase holds N + 2 handles, too few with the bin's walls.
     bullet::DropSettings s = bench::bullet_drop_settings(setup.body, m.bullet_method, "dbvt", drop);
     s.planes = planes;
-    sim = bench::make_bullet(bench::make_bullet_shapes(setup.body), m.bullet_method, s, sc.bodies, dt);
+    if (sc.shapes.empty())
+      sim = bench::make_bullet(bench::make_bullet_shapes(setup.body), m.bullet_method, s, sc.bodies, dt);
+    else
+      sim = bench::make_bullet_mixed({bench::make_bullet_shapes(setup.body), bench::make_bullet_shapes(setup.mix_body)},
+                                     sc.shapes, m.bullet_method, s, sc.bodies, dt);
   } else {
     // The statsim world adds the ground itself; the rest are walls.
     const std::vector<bullet::Plane> walls(planes.begin() + 1, planes.end());
-    sim = bench::make_statsim3_table(m.table, setup.body.mass, drop, world_seed, dt, "", m.variant, walls);
+    if (sc.shapes.empty())
+      sim = bench::make_statsim3_table(m.table, setup.body.mass, drop, world_seed, dt, "", m.variant, walls);
+    else
+      sim = bench::make_statsim3_mixed({m.table, setup.mix_table}, {setup.body.mass, setup.mix_body.mass}, sc.shapes,
+                                       drop, world_seed, dt, m.variant, walls);
   }
   const bool stack = sc.kind == "column" || sc.kind == "wall";
   // The heap's time limit counts from its last release.
@@ -1020,6 +1063,7 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
   std::vector<double> quiet_since(n, -1);
   const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));
   SceneOutcome out;
+  out.shapes = sc.shapes;
   out.run.time_limited = !stack;
   out.states.resize(n);
   double t = 0;
@@ -1033,7 +1077,7 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
     bool all = true;
     for (std::size_t i = 0; i < n; ++i) {
       const scenes::BodyState3 s = sim->body_state(i);
-      if (speed(s, setup.radius) < kQuietSpeed) {
+      if (speed(s, radius) < kQuietSpeed) {
         if (quiet_since[i] < 0) quiet_since[i] = t;
       } else {
         quiet_since[i] = -1;
@@ -1056,12 +1100,16 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
     out.run.all_asleep = out.run.all_asleep && out.asleep[i];
   }
   if (sc.kind == "heap") {
-    const scenes::HeapProfile h = scenes::heap_profile(centres, setup.radius, 0.5 * setup.radius);
+    const scenes::HeapProfile h = scenes::heap_profile(centres, radius, 0.5 * radius);
     out.run.values = {h.angle_deg, h.height};
   } else if (sc.kind == "bin") {
     std::vector<double> z;
     for (const Eigen::Vector3d& c : centres) z.push_back(c.z());
     const double side = 2 * sc.bin_half_width;
+    // A mixed bin: the mean volume of its bodies.
+    double volume = 0;
+    for (std::size_t i = 0; i < n; ++i) volume += volumes[sc.shapes.empty() ? 0 : static_cast<std::size_t>(sc.shapes[i])];
+    volume /= static_cast<double>(n);
     const scenes::BinFill f = scenes::bin_fill(z, volume, side * side);
     out.run.values = {f.fill_height, f.packing};
   } else {
@@ -1075,13 +1123,15 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
   return out;
 }
 
-void write_scene_frames(const std::string& path, const std::string& shape, const SceneOutcome& r)
+void write_scene_frames(const std::string& path, const Setup& setup, const SceneOutcome& r)
 {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) throw std::runtime_error("cannot write " + path);
   scenes::write_frames_header(f);
   for (std::size_t i = 0; i < r.states.size(); ++i)
-    scenes::write_frame_row(f, 0, r.run.seconds, static_cast<std::uint32_t>(i), shape.c_str(), r.states[i].position,
+    scenes::write_frame_row(f, 0, r.run.seconds, static_cast<std::uint32_t>(i),
+                            (!r.shapes.empty() && r.shapes[i] == 1 ? setup.mix_body : setup.body).shape.c_str(),
+                            r.states[i].position,
                             r.states[i].orientation, r.asleep[i] ? 2 : 0, 0.0);
   if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + path);
 }
@@ -1138,7 +1188,8 @@ void summarise(SceneSample& s, const std::vector<SceneMetric>& metrics, const st
 std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o, unsigned threads)
 {
   std::vector<SceneResult> results;
-  const double volume = mesh_volume(setup.body);
+  std::vector<double> volumes{mesh_volume(setup.body)};
+  if (setup.mixed) volumes.push_back(mesh_volume(setup.mix_body));
   const std::size_t seeds = static_cast<std::size_t>(o.scene_seeds);
   const std::size_t samples = 2 + setup.methods.size();
   MethodSpec ref;
@@ -1159,7 +1210,7 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
           const std::uint64_t seed = 1 + k + (sample == 1 ? seeds : 0);
           const MethodSpec& m = sample < 2 ? ref : setup.methods[sample - 2];
           const double dt = sample < 2 ? o.pile_reference_dt : o.dt;
-          SceneOutcome r = run_scene(setup, m, make_scene(setup, o, kind, seed), o, dt, mix(o.seed, seed), volume);
+          SceneOutcome r = run_scene(setup, m, make_scene(setup, o, kind, seed), o, dt, mix(o.seed, seed), volumes);
           progress.add();
           if (k != 0 || o.scene_frames.empty()) r.states.clear();
           return r;
@@ -1181,7 +1232,7 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
       if (!all[job].states.empty()) {
         const std::string file = o.scene_frames + "/" + kind + "_" + (sample == 0 ? std::string("reference") : s.name) +
                                  ".csv";
-        if (sample != 1) write_scene_frames(file, setup.body.shape, all[job]);
+        if (sample != 1) write_scene_frames(file, setup, all[job]);
       }
     }
     summarise(res.reference, res.metrics, nullptr, o.bootstrap);
@@ -1205,6 +1256,7 @@ FidelityResult run_fidelity(const FidelityOptions& options)
   FidelityResult res;
   res.options = options;
   res.shape = options.mesh.empty() ? options.shape : options.mesh;
+  if (!options.mix.empty()) res.shape += " and " + options.mix + " (mixed, half and half)";
   res.bounding_radius = setup->radius;
   for (std::uint32_t i = 0; i < setup->poses.rest.count; ++i) {
     char b[160];

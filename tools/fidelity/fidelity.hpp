@@ -57,6 +57,10 @@ struct FidelityOptions {
   int wall_height = 5;               ///< bodies per column of the wall
   double stack_time = 3.0;           ///< s, simulated time of the column and the wall
   std::string scene_frames;          ///< directory: final states of seed 1 as frame files; empty: none
+  /// Mixed heap and bin: half their bodies of this second shape (bunny, box or lshape, with its
+  /// compiled table), taken in turn with `shape`'s; empty: one shape. Methods: statistical and
+  /// Bullet full only.
+  std::string mix;
 };
 
 /// Method names used when none are given: full, low, spheres7, sphere, statistical,

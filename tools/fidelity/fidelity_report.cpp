@@ -198,6 +198,7 @@ std::string command_line(const FidelityOptions& o)
     c << " --scene-seeds " << o.scene_seeds << " --heap-count " << o.heap_count << " --bin-count " << o.bin_count
       << " --bin-cells " << o.bin_cells << " --column-height " << o.column_height << " --wall-columns "
       << o.wall_columns << " --wall-height " << o.wall_height << " --stack-time " << o.stack_time;
+    if (!o.mix.empty()) c << " --mix " << o.mix;
   }
   c << " --seed " << o.seed << " --bootstrap " << o.bootstrap;
   return c.str();
@@ -260,7 +261,8 @@ std::string fidelity_json(const FidelityResult& r)
                   {"column_height", r.options.column_height},
                   {"wall_columns", r.options.wall_columns},
                   {"wall_height", r.options.wall_height},
-                  {"stack_time", r.options.stack_time}};
+                  {"stack_time", r.options.stack_time},
+                  {"mix", r.options.mix}};
   json ref = sample_json(r.reference, configs);
   ref["method"] = "full";
   ref["reference"] = r.options.reference;
@@ -499,6 +501,9 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--wall-height", opts->wall_height, "bodies per column of the wall")->capture_default_str();
   cmd->add_option("--stack-time", opts->stack_time, "s simulated before the column and the wall are measured")
       ->capture_default_str();
+  cmd->add_option("--mix", opts->mix,
+                  "heap and bin: half the bodies of this second shape (bunny, box, lshape), in turn with --shape's; "
+                  "methods statistical and full only");
   cmd->add_option("--scene-frames", opts->scene_frames,
                   "directory: the final state of seed 1 of each scene, reference A and each method, as frame files "
                   "(KIND_METHOD.csv) for statsim render");

@@ -50,6 +50,14 @@ std::vector<int> shuffled(int n, int take, SceneRng& rng)
   return idx;
 }
 
+// Body i of shape i % shapes, when the scene mixes two shapes.
+void assign_shapes(const char* scene, int shapes, PileScene3& sc)
+{
+  if (shapes < 1 || shapes > 2) bad(scene, "shapes must be 1 or 2");
+  if (shapes == 1) return;
+  for (std::size_t i = 0; i < sc.bodies.size(); ++i) sc.shapes.push_back(static_cast<int>(i % 2));
+}
+
 }  // namespace
 
 DropScene3 PileScene3::as_drop_scene() const
@@ -115,6 +123,7 @@ PileScene3 heap_scene(const HeapOptions& o)
   const double half = 0.5 * g * s + 1;
   sc.bounds_lo = Eigen::Vector3d(-std::max(reach, half), -std::max(reach, half), -1);
   sc.bounds_hi = Eigen::Vector3d(std::max(reach, half), std::max(reach, half), park + 1);
+  assign_shapes("heap", o.shapes, sc);
   return sc;
 }
 
@@ -151,6 +160,7 @@ PileScene3 bin_scene(const BinOptions& o)
   const double top = (full_layers + 2) * s;
   sc.bounds_lo = Eigen::Vector3d(-w - 1, -w - 1, -1);
   sc.bounds_hi = Eigen::Vector3d(w + 1, w + 1, top + 1);
+  assign_shapes("bin", o.shapes, sc);
   return sc;
 }
 

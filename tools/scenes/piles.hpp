@@ -20,6 +20,9 @@
 //    cells x cells lattice of side s inside the walls, layer after layer from z = s up (a full
 //    layer before the next; within the top layer, the cells in a random order), jittered,
 //    oriented and moving as above.
+//  - mixed heap or bin (`shapes` = 2): the same scene, its bodies of two shapes taken in turn
+//    (body i of shape i % 2: half and half, spread evenly through the pour and the layers); R is
+//    the larger bounding radius of the two, so that either fits a cell.
 //  - stack: `columns` columns of `height` bodies, all in one orientation (a rest pose) with no
 //    velocity; in a column, each body's lowest point touches the highest point of the body below
 //    (the first touches the ground); columns side by side along x, touching: the pitches are the
@@ -65,6 +68,9 @@ struct PileScene3 {
   /// time, s; empty for scenes whose bodies all start where they are.
   std::vector<BodyState3> release;
   std::vector<double> release_time;
+  /// heap, bin: the shape of body i (0 or 1, an index into the runner's shapes) when the scene
+  /// mixes two; empty when every body is of one shape.
+  std::vector<int> shapes;
   double nozzle_height = 0.0;  ///< heap: m
   double pour_speed = 0.0;     ///< heap: m/s downwards at release, besides the random velocity
   Eigen::Vector3d bounds_lo = Eigen::Vector3d::Zero();  ///< m, a box that holds the run
@@ -84,6 +90,7 @@ struct HeapOptions {
   double spacing = 1.05;         ///< s / (2 R), >= 1
   double max_speed = 0.05;       ///< m/s, bound of each velocity component (besides pour_speed), >= 0
   double max_spin = 0.5;         ///< rad/s, bound of each spin component, >= 0
+  int shapes = 1;                ///< 1, or 2: bodies of two shapes in turn (PileScene3::shapes)
 };
 /// Throws std::invalid_argument naming the first option out of range.
 PileScene3 heap_scene(const HeapOptions& options);
@@ -97,6 +104,7 @@ struct BinOptions {
   double spacing = 1.05;         ///< s / (2 R), >= 1
   double max_speed = 0.05;       ///< m/s
   double max_spin = 0.5;         ///< rad/s
+  int shapes = 1;                ///< 1, or 2: bodies of two shapes in turn (PileScene3::shapes)
 };
 PileScene3 bin_scene(const BinOptions& options);
 
