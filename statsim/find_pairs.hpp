@@ -27,7 +27,7 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, std::uint32_t&
 /// bodies in the 3^D cells around its own. Returns how many were found (also those that did not
 /// fit the buffer).
 template <int D>
-std::uint32_t find_pairs_grid(WorldData<D>& w)
+std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
 {
   SpatialHash<D>& grid = w.grid;
   Scalar widest = 0;
@@ -42,11 +42,11 @@ std::uint32_t find_pairs_grid(WorldData<D>& w)
     return GridItem<D>{b.position, b.bounding_radius, i, b.state != MotionState::asleep ? 1u : 0u};
   };
   grid.build(w.body_count, cell, item);
-  std::uint32_t found = 0;
+  result.broad_phase_bodies += w.body_count;
+  std::uint32_t found = 0, examined = 0;
   constexpr int neighbours = D == 3 ? 27 : 9;
-  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     const Body<D>& bi = w.bodies[i];
-    if (bi.state == MotionState::asleep) continue;
     std::int32_t c[3];
     cell(i, c);
     std::uint32_t seen[neighbours];
@@ -68,26 +68,33 @@ std::uint32_t find_pairs_grid(WorldData<D>& w)
       seen[seen_count++] = b;
       const GridItem<D>* it = grid.items + grid.start[b];
       const GridItem<D>* const end = grid.items + grid.start[b + 1];
+      examined += std::uint32_t(end - it);
       for (; it != end; ++it) {
         const std::uint32_t j = it->body;
-        // An awake pair is found once, from its lower index; a sleeper never looks itself.
-        if (j == i || (j < i && it->awake)) continue;
-        // As `candidate`, from the grid's copy of body j.
+        // An awake pair is found once, from its lower index; a sleeper never looks itself. As
+        // `candidate`, from the grid's copy of body j. Both tests are taken together, so that
+        // the one branch is nearly always the same way (the index test alone goes either way).
+        const bool wanted = j > i || (j < i && !it->awake);
         const Scalar reach = bi.bounding_radius + it->reach;
-        if ((it->position - bi.position).squaredNorm() > reach * reach) continue;
+        const bool near = !((it->position - bi.position).squaredNorm() > reach * reach);
+        if (!(wanted & near)) continue;
         if (found < w.max_pairs) w.pairs[found] = Pair{i < j ? i : j, i < j ? j : i};
         ++found;
       }
     }
-  }
+  });
+  result.pairs_examined += examined;
   return found;
 }
 
 /// Pairs from sweep-and-prune along `WorldDef::sweep_axis`. The entries keep last step's order,
 /// so the insertion sort has little to do. Returns how many pairs were found.
 template <int D>
-std::uint32_t find_pairs_sweep(WorldData<D>& w)
+std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
 {
+  // With no body awake there is no pair; if the entries were sorted on the bodies' present
+  // places (a sweep with none awake, after which nothing moved) the sweep would not change them.
+  if (w.awake_count == 0 && w.sweep_current && w.entry_count == w.body_count) return 0;
   // Bodies added since the last sweep join at the end, in order of creation.
   for (; w.entry_count < w.body_count; ++w.entry_count)
     w.entries[w.entry_count] = SweepEntry{0, 0, w.entry_count, 1};
@@ -101,10 +108,16 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w)
     e.active = b.state != MotionState::asleep ? 1u : 0u;
     widest = 2 * b.bounding_radius > widest ? 2 * b.bounding_radius : widest;
   }
+  result.broad_phase_bodies += w.body_count;
   insertion_sort(w.entries, w.body_count);
-  std::uint32_t found = 0;
-  sweep_active(w.entries, w.body_count, widest,
-               [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, found); });
+  // Nothing moves in a step without awake bodies: the order stays valid for the next.
+  w.sweep_current = w.awake_count == 0;
+  std::uint32_t found = 0, examined = 0;
+  sweep_active(w.entries, w.body_count, widest, [&](std::uint32_t a, std::uint32_t b) {
+    ++examined;
+    candidate(w, a, b, found);
+  });
+  result.pairs_examined += examined;
   return found;
 }
 
@@ -115,7 +128,15 @@ void find_pairs(WorldData<D>& w, StepResult& result)
 {
   const bool grid = w.def.broad_phase == BroadPhase::grid ||
                     (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies);
-  const std::uint32_t found = grid ? find_pairs_grid(w) : find_pairs_sweep(w);
+  std::uint32_t found = 0;
+  if (grid) {
+    // The grid keeps nothing from step to step but its sizes; bodies move under the entries.
+    w.sweep_current = false;
+    // Two sleepers are never a pair.
+    if (w.awake_count > 0) found = find_pairs_grid(w, result);
+  } else {
+    found = find_pairs_sweep(w, result);
+  }
   result.pairs_found = found;
   if (found > w.max_pairs) {
     result.pairs_dropped = found - w.max_pairs;

@@ -62,7 +62,10 @@ class WorldCore {
   Status configure(const WorldDef<D>& def)
   {
     const Status s = detail::check_world_def(def);
-    if (s == Status::ok) w_.def = def;
+    if (s == Status::ok) {
+      w_.def = def;
+      w_.sweep_current = false;  // the sweep axis may have changed
+    }
     return s;
   }
   const WorldDef<D>& def() const { return w_.def; }
@@ -185,6 +188,10 @@ class WorldCore {
     b.rest_pose = no_rest_pose;
     b.pile_rest = false;
     b.rest_blend = 0;
+    if (!def.asleep) {
+      detail::set_bit(w_.awake, id);
+      ++w_.awake_count;
+    }
     ++w_.body_count;
     return {Status::ok, id};
   }
@@ -198,7 +205,7 @@ class WorldCore {
     Body<D>& b = w_.bodies[id];
     b.linear_velocity = linear;
     b.angular_velocity = angular;
-    detail::wake(b);
+    detail::wake(w_, b);
     return Status::ok;
   }
 
@@ -211,7 +218,7 @@ class WorldCore {
     Body<D>& b = w_.bodies[id];
     b.position = position;
     b.orientation = detail::normalized(orientation);
-    detail::wake(b);
+    detail::wake(w_, b);
     return Status::ok;
   }
 
@@ -229,7 +236,7 @@ class WorldCore {
     detail::StepContext ctx;
     ctx.dt = dt;
     ctx.tilted_planes = detail::any_tilted_plane(w_);
-    detail::integrate(w_, dt);
+    result.bodies_integrated = detail::integrate(w_, dt);
     detail::update_radii(w_);
     detail::find_pairs(w_, result);
     detail::forget_contacts(w_);
@@ -326,6 +333,8 @@ class WorldCore {
     Shape<D>* shapes;
     std::uint32_t* grid_start;
     detail::GridItem<D>* grid_items;
+    std::uint32_t* awake;
+    std::uint32_t* flagged;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   };
 
@@ -336,6 +345,8 @@ class WorldCore {
            s.planes,
            s.shapes,
            detail::SpatialHash<D>{s.grid_start, s.grid_items, detail::grid_buckets(s.max_bodies)},
+           s.awake,
+           s.flagged,
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
@@ -363,6 +374,8 @@ struct WorldStorage {
   std::array<Shape<D>, MaxShapes> shape_store;
   std::array<std::uint32_t, detail::grid_buckets(MaxBodies) + 1> grid_start_store;
   std::array<detail::GridItem<D>, MaxBodies> grid_item_store;
+  std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
+  std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
 };
 }  // namespace detail
 
@@ -392,7 +405,9 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                                                      StorageBase::pair_store.data(), StorageBase::plane_store.data(),
                                                      StorageBase::shape_store.data(),
                                                      StorageBase::grid_start_store.data(),
-                                                     StorageBase::grid_item_store.data(), MaxBodies, MaxPairs, MaxPlanes,
+                                                     StorageBase::grid_item_store.data(),
+                                                     StorageBase::awake_store.data(),
+                                                     StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
                                                      MaxShapes},
                      def)
   {
