@@ -177,6 +177,7 @@ class WorldCore {
                    ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
                    : shape.radius;
     b.bounding_radius = shape.bounding_radius;
+    w_.widest = 2 * b.bounding_radius > w_.widest ? 2 * b.bounding_radius : w_.widest;
     b.inv_mass = Scalar(1) / mass;
     b.slow_time = 0;
     b.step_start = b.position;
@@ -327,12 +328,10 @@ class WorldCore {
   /// Storage a `World<>` hands to its core.
   struct Storage {
     Body<D>* bodies;
-    SweepEntry* entries;
+    unsigned char* broad_phase;  ///< `detail::BroadPhaseLayout<D>::bytes(max_bodies)`, aligned for 16-byte records
     Pair* pairs;
     Plane<D>* planes;
     Shape<D>* shapes;
-    std::uint32_t* grid_start;
-    detail::GridItem<D>* grid_items;
     std::uint32_t* awake;
     std::uint32_t* flagged;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
@@ -340,11 +339,15 @@ class WorldCore {
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
       : w_{s.bodies,
-           s.entries,
+           reinterpret_cast<SweepEntry*>(s.broad_phase + detail::BroadPhaseLayout<D>::order(s.max_bodies)),
+           reinterpret_cast<std::uint32_t*>(s.broad_phase + detail::BroadPhaseLayout<D>::order(s.max_bodies)),
            s.pairs,
            s.planes,
            s.shapes,
-           detail::SpatialHash<D>{s.grid_start, s.grid_items, detail::grid_buckets(s.max_bodies)},
+           detail::SpatialHash<D>{
+               reinterpret_cast<std::uint32_t*>(s.broad_phase + detail::BroadPhaseLayout<D>::start(s.max_bodies)),
+               reinterpret_cast<detail::GridItem<D>*>(s.broad_phase + detail::BroadPhaseLayout<D>::items(s.max_bodies)),
+               detail::grid_buckets(s.max_bodies)},
            s.awake,
            s.flagged,
            s.max_bodies,
@@ -368,12 +371,10 @@ namespace detail {
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes>
 struct WorldStorage {
   std::array<Body<D>, MaxBodies> body_store;
-  std::array<SweepEntry, MaxBodies> entry_store;
+  alignas(16) std::array<unsigned char, detail::BroadPhaseLayout<D>::bytes(MaxBodies)> broad_phase_store;
   std::array<Pair, MaxPairs> pair_store;
   std::array<Plane<D>, MaxPlanes> plane_store;
   std::array<Shape<D>, MaxShapes> shape_store;
-  std::array<std::uint32_t, detail::grid_buckets(MaxBodies) + 1> grid_start_store;
-  std::array<detail::GridItem<D>, MaxBodies> grid_item_store;
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
 };
@@ -401,11 +402,10 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   /// `construction_status()` says why.
   explicit World(const WorldDef<D>& def = {})
       : StorageBase(),
-        WorldCore<D>(typename WorldCore<D>::Storage{StorageBase::body_store.data(), StorageBase::entry_store.data(),
+        WorldCore<D>(typename WorldCore<D>::Storage{StorageBase::body_store.data(),
+                                                     StorageBase::broad_phase_store.data(),
                                                      StorageBase::pair_store.data(), StorageBase::plane_store.data(),
                                                      StorageBase::shape_store.data(),
-                                                     StorageBase::grid_start_store.data(),
-                                                     StorageBase::grid_item_store.data(),
                                                      StorageBase::awake_store.data(),
                                                      StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
                                                      MaxShapes},

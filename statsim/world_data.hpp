@@ -57,7 +57,11 @@ inline void clear_bit(std::uint32_t* words, std::uint32_t i)
 template <int D>
 struct WorldData {
   Body<D>* bodies;
-  SweepEntry* entries;  ///< the sweep-and-prune order of the first `entry_count` bodies
+  /// The sweep-and-prune order of the first `entry_count` bodies: in `entries` while
+  /// sweep-and-prune runs, as body indices in `order` while the grid does (`grid_layout`); the
+  /// two share their storage with the grid's (`BroadPhaseLayout`).
+  SweepEntry* entries;
+  std::uint32_t* order;
   Pair* pairs;
   Plane<D>* planes;
   Shape<D>* shapes;
@@ -74,9 +78,11 @@ struct WorldData {
   /// next runs, so the grid never touches them.
   std::uint32_t entry_count = 0;
   std::uint32_t awake_count = 0;  ///< bodies not asleep
+  Scalar widest = 0;  ///< the largest bounding diameter of the bodies, m
   /// The sweep-and-prune entries hold every body's interval, sorted, and no body has moved since:
   /// a sweep with no awake body would change nothing and find no pair.
   bool sweep_current = false;
+  bool grid_layout = false;  ///< the broad phase's block holds the grid (see `entries`)
   std::uint64_t step_count = 0;
   std::uint64_t energy_clamps = 0;  ///< over the world's life
   std::uint64_t statistical_responses = 0;  ///< over the world's life
@@ -246,7 +252,7 @@ std::uint64_t state_hash(const WorldData<D>& w)
   // The sweep-and-prune order breaks ties between equal interval starts, so it decides the order
   // of pairs, and with it of contacts.
   h.add(w.entry_count);
-  for (std::uint32_t i = 0; i < w.entry_count; ++i) h.add(w.entries[i].body);
+  for (std::uint32_t i = 0; i < w.entry_count; ++i) h.add(w.grid_layout ? w.order[i] : w.entries[i].body);
   return h.value;
 }
 
