@@ -280,14 +280,13 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
     if (!resolve(a, b, c, slop, reach)) continue;
     a.touching = true;
     b.touching = true;
-    set_bit(w.flagged, w.pairs[k].a);
-    set_bit(w.flagged, w.pairs[k].b);
   }
   return touching;
 }
 
 /// Clears the contact flags of every body: the passes of this step set them again. Only awake
-/// bodies and flagged sleepers can have them set.
+/// bodies, bodies of last step's touching pairs and bodies that fell asleep in it can have them
+/// set. Runs before the broad phase replaces the pairs.
 template <int D>
 void forget_contacts(WorldData<D>& w)
 {
@@ -297,6 +296,10 @@ void forget_contacts(WorldData<D>& w)
   };
   for_each_set(w.awake, w.body_count, forget);
   for_each_set(w.flagged, w.body_count, forget);
+  for (std::uint32_t k = 0; k < w.touching_pairs; ++k) {
+    forget(w.pairs[k].a);
+    forget(w.pairs[k].b);
+  }
   for (std::uint32_t k = 0; k < bit_words(w.body_count); ++k) w.flagged[k] = 0;
 }
 

@@ -239,8 +239,9 @@ class WorldCore {
     ctx.tilted_planes = detail::any_tilted_plane(w_);
     result.bodies_integrated = detail::integrate(w_, dt);
     detail::update_radii(w_);
-    detail::find_pairs(w_, result);
+    // Before the broad phase, which replaces last step's pairs (it does not read the flags).
     detail::forget_contacts(w_);
+    detail::find_pairs(w_, result);
     result.contacts += detail::impact_pass(w_, ctx);
     // A support pass that changed no velocity and moved nothing would be repeated exactly by
     // the next one: stop there (a resting pile needs one pass, not `support_iterations`; the
@@ -254,6 +255,7 @@ class WorldCore {
       for (int i = 0; i < w_.def.position_iterations && moves > 0; ++i) moves = detail::position_pass(w_, ctx);
     }
     detail::update_motion_states(w_, dt);
+    w_.touching_pairs = ctx.touching;
     result.energy_clamps = ctx.energy_clamps;
     result.statistical_responses = ctx.statistical_responses;
     w_.energy_clamps += ctx.energy_clamps;

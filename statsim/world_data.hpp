@@ -69,14 +69,16 @@ struct WorldData {
   /// Bit set of the bodies that are not asleep: the phases of a step walk these, so a sleeping
   /// body costs nothing until it wakes.
   std::uint32_t* awake;
-  /// Bit set of sleepers whose `touching` or `on_ground` may be set (they fell asleep touching,
-  /// or an awake body touched them): the next step clears their flags with the awake bodies'.
+  /// Bit set of the bodies that fell asleep in the last step, whose `touching` and `on_ground`
+  /// may still be set: the next step clears their flags with the awake bodies' and those of the
+  /// last step's touching pairs (the only sleepers the passes mark).
   std::uint32_t* flagged;
   std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   std::uint32_t body_count = 0, pair_count = 0, plane_count = 0, shape_count = 0;
   /// Bodies that have a sweep entry: sweep-and-prune adds the entries of newer bodies when it
   /// next runs, so the grid never touches them.
   std::uint32_t entry_count = 0;
+  std::uint32_t touching_pairs = 0;  ///< last step's touching pairs, at the front of `pairs`
   std::uint32_t awake_count = 0;  ///< bodies not asleep
   Scalar widest = 0;  ///< the largest bounding diameter of the bodies, m
   /// The sweep-and-prune entries hold every body's interval, sorted, and no body has moved since:

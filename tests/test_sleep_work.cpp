@@ -63,7 +63,7 @@ void check_asleep_steps(World& w)
 }
 
 /// Wakes the pile by dropping a body onto it: the step integrates the awake body, then the woken
-/// ones, and the broad phase examines pairs again.
+/// ones, and the broad phase runs again.
 template <int D, class World>
 void check_wakes(World& w)
 {
@@ -79,7 +79,7 @@ void check_wakes(World& w)
     const std::uint32_t awake = w.body_count() - w.count(MotionState::asleep);
     const StepResult r = w.step(1.0f / 60);
     CHECK(r.bodies_integrated == awake);
-    CHECK(r.pairs_examined > 0);
+    CHECK(r.broad_phase_bodies > 0);
     woke = w.body_count() - w.count(MotionState::asleep) > 1;
   }
   CHECK(woke);
