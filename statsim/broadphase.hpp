@@ -12,7 +12,9 @@
 #include "statsim/math.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <new>
 
 namespace statsim {
 
@@ -102,15 +104,40 @@ constexpr std::uint32_t grid_buckets(std::uint32_t bodies)
 }
 
 /// One body as the grid's pair search sees it, stored in bucket order. The search reads these
-/// records in sequence instead of gathering position, radius and state from the bodies: at 10,000
-/// bodies the body array is far larger than the cache, and each awake body visits about twenty
-/// others in its 3^D cells.
+/// records in sequence instead of gathering positions from the bodies: at 10,000 bodies the body
+/// array is far larger than the cache, and each awake body visits about twenty others in its 3^D
+/// cells.
 template <int D>
 struct GridItem {
   typename Space<D>::Vec position;  ///< centre, m
-  Scalar reach;                     ///< bounding radius, m
-  std::uint32_t body;               ///< index in the world
-  std::uint32_t awake;              ///< 1 unless asleep
+  /// The body's index, plus `asleep_key` for a sleeper: from awake body i the search wants the
+  /// bodies with key > i (awake ones of higher index, and every sleeper) in one comparison.
+  std::uint32_t key;
+};
+
+/// Added to a sleeper's index in `GridItem::key` (indices stay below it).
+constexpr std::uint32_t asleep_key = std::uint32_t(1) << 31;
+
+/// The storage of the broad phase of a world of `bodies` bodies, one phase at a time: the
+/// sweep-and-prune entries; or, for the grid, the sweep order kept as body indices (so that a
+/// world that goes back to sweep-and-prune finds its order), then the grid's items and bucket
+/// starts. Byte offsets into one block (`broad_phase_bytes`).
+template <int D>
+struct BroadPhaseLayout {
+  static constexpr std::size_t order(std::uint32_t) { return 0; }
+  static constexpr std::size_t items(std::uint32_t bodies) { return sizeof(std::uint32_t) * std::size_t(bodies); }
+  static constexpr std::size_t start(std::uint32_t bodies)
+  {
+    return items(bodies) + sizeof(GridItem<D>) * std::size_t(bodies);
+  }
+  static constexpr std::size_t bytes(std::uint32_t bodies)
+  {
+    const std::size_t grid = start(bodies) + sizeof(std::uint32_t) * (std::size_t(grid_buckets(bodies)) + 1);
+    const std::size_t sweep = sizeof(SweepEntry) * std::size_t(bodies);
+    return grid > sweep ? grid : sweep;
+  }
+  static_assert(alignof(GridItem<D>) <= alignof(std::uint32_t) && alignof(SweepEntry) <= alignof(std::uint32_t) * 4,
+                "the block is aligned for its widest record");
 };
 
 /// Hashed uniform grid over caller-owned arrays: `start` has max_buckets + 1 entries, `items` one
@@ -147,7 +174,7 @@ struct SpatialHash {
     // clearing empty buckets.
     const std::uint32_t wanted = grid_buckets(count);
     buckets = wanted < max_buckets ? wanted : max_buckets;
-    for (std::uint32_t b = 0; b <= buckets; ++b) start[b] = 0;
+    for (std::uint32_t b = 0; b <= buckets; ++b) new (&start[b]) std::uint32_t(0);
     for (std::uint32_t i = 0; i < count; ++i) {
       std::int32_t c[3];
       cell(i, c);
@@ -159,7 +186,8 @@ struct SpatialHash {
       std::int32_t c[3];
       cell(i, c);
       const std::uint32_t b = bucket(c[0], c[1], c[2]);
-      items[--start[b + 1]] = item(i);
+      // Placement: the block held sweep-and-prune entries when that phase last ran.
+      new (&items[--start[b + 1]]) GridItem<D>(item(i));
     }
     // The descending fill left start[b + 1] at the first item of bucket b: shift it to start[b],
     // so that bucket b is items[start[b]] .. items[start[b + 1] - 1].

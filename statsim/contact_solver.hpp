@@ -220,9 +220,8 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
   using Vec = typename Space<D>::Vec;
   const Vec& g = w.def.gravity;
   std::uint32_t contacts = 0;
-  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
-    if (b.state == MotionState::asleep) continue;
     for (std::uint32_t p = 0; p < w.plane_count; ++p) {
       Contact<D> c;
       // Passes after the impact pass also see a body that the last pass left exactly touching.
@@ -258,7 +257,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       const Scalar held = pull * ctx.dt;
       if (taken > 0) b.position -= downhill * ((taken < held ? taken : held) * ctx.dt);
     }
-  }
+  });
   return contacts;
 }
 
@@ -287,14 +286,23 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
   return touching;
 }
 
-/// Clears every body's contact flags: the passes of this step set them again.
+/// Clears the contact flags of every body: the passes of this step set them again. Only awake
+/// bodies, bodies of last step's touching pairs and bodies that fell asleep in it can have them
+/// set. Runs before the broad phase replaces the pairs.
 template <int D>
 void forget_contacts(WorldData<D>& w)
 {
-  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+  const auto forget = [&w](std::uint32_t i) {
     w.bodies[i].touching = false;
     w.bodies[i].on_ground = false;
+  };
+  for_each_set(w.awake, w.body_count, forget);
+  for_each_set(w.flagged, w.body_count, forget);
+  for (std::uint32_t k = 0; k < w.touching_pairs; ++k) {
+    forget(w.pairs[k].a);
+    forget(w.pairs[k].b);
   }
+  for (std::uint32_t k = 0; k < bit_words(w.body_count); ++k) w.flagged[k] = 0;
 }
 
 /// The plane contacts of a support pass (and of the shock pass): inelastic particle responses.
@@ -332,8 +340,8 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
       // An awake body hitting a sleeper fast enough wakes it; otherwise the sleeper is static.
       const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(n);
       if (approach > def.wake_speed) {
-        if (a_asleep) wake(a);
-        if (b_asleep) wake(b);
+        if (a_asleep) wake(w, a);
+        if (b_asleep) wake(w, b);
       }
     }
     Scalar ima, imb;

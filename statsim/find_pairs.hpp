@@ -6,7 +6,9 @@
 
 #include "statsim/world_data.hpp"
 
+#include <cmath>
 #include <cstdint>
+#include <new>
 
 namespace statsim {
 namespace detail {
@@ -27,70 +29,110 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, std::uint32_t&
 /// bodies in the 3^D cells around its own. Returns how many were found (also those that did not
 /// fit the buffer).
 template <int D>
-std::uint32_t find_pairs_grid(WorldData<D>& w)
+std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
 {
   SpatialHash<D>& grid = w.grid;
-  Scalar widest = 0;
-  for (std::uint32_t i = 0; i < w.body_count; ++i)
-    widest = 2 * w.bodies[i].bounding_radius > widest ? 2 * w.bodies[i].bounding_radius : widest;
+  const Scalar widest = w.widest;
   grid.inv_cell = Scalar(1) / widest;
-  const auto cell = [&w, &grid](std::uint32_t i, std::int32_t* c) {
-    for (int k = 0; k < 3; ++k) c[k] = k < D ? grid.cell_of(w.bodies[i].position[k], grid.inv_cell) : 0;
+  // Bodies far out (or not finite) share clamped cells: then every neighbouring cell is visited.
+  bool regular = true;
+  const auto cell = [&w, &grid, &regular](std::uint32_t i, std::int32_t* c) {
+    for (int k = 0; k < 3; ++k) {
+      c[k] = k < D ? grid.cell_of(w.bodies[i].position[k], grid.inv_cell) : 0;
+      regular = regular && c[k] > -100000000 && c[k] < 100000000;
+    }
   };
   const auto item = [&w](std::uint32_t i) {
     const Body<D>& b = w.bodies[i];
-    return GridItem<D>{b.position, b.bounding_radius, i, b.state != MotionState::asleep ? 1u : 0u};
+    return GridItem<D>{b.position, b.state != MotionState::asleep ? i : i + asleep_key};
   };
   grid.build(w.body_count, cell, item);
-  std::uint32_t found = 0;
+  result.broad_phase_bodies += w.body_count;
+  std::uint32_t found = 0, examined = 0;
   constexpr int neighbours = D == 3 ? 27 : 9;
-  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+  const Scalar half_cell = Scalar(0.5) * widest * grid.inv_cell;  // the widest bounding radius, in cells
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     const Body<D>& bi = w.bodies[i];
-    if (bi.state == MotionState::asleep) continue;
     std::int32_t c[3];
     cell(i, c);
-    std::uint32_t seen[neighbours];
-    int seen_count = 0;
-    // Buckets seen so far, by their low 6 bits: a clear bit proves a bucket new without
-    // comparing it with every one before (neighbouring cells rarely share a bucket).
-    std::uint64_t seen_bits = 0;
+    // Where the body is in its cell, in cells: a neighbouring cell holds a body it can touch only
+    // if the cell comes within the body's reach (its bounding radius and the widest one). Cells
+    // beyond it are skipped, with a margin for the rounding of x / cell.
+    Scalar low[3] = {0, 0, 0}, high[3] = {0, 0, 0};
+    Scalar margin = Scalar(0.01);
+    for (int k = 0; k < D; ++k) {
+      const Scalar u = bi.position[k] * grid.inv_cell;
+      low[k] = u - std::floor(u);
+      high[k] = 1 - low[k];
+      margin += std::fabs(u) * Scalar(1e-6);
+    }
+    const Scalar r = bi.bounding_radius * grid.inv_cell + half_cell + margin;
+    const Scalar r2 = r * r;
+    const Scalar reach_max = bi.bounding_radius + Scalar(0.5) * widest;
+    const Scalar reach_max2 = reach_max * reach_max;
+    // A bucket is searched once, where it first comes in the order of the cells, if any of
+    // its cells is within reach: the pairs come in the same order as from searching them all.
+    std::uint32_t bucket[neighbours];
+    bool visit[neighbours];
+    // Buckets by their low 6 bits: a clear bit proves a bucket new without comparing it with
+    // every one before (neighbouring cells rarely share a bucket).
+    std::uint64_t bucket_bits = 0;
     for (int n = 0; n < neighbours; ++n) {
-      const std::int32_t dx = n % 3 - 1, dy = (n / 3) % 3 - 1, dz = D == 3 ? n / 9 - 1 : 0;
-      const std::uint32_t b = grid.bucket(c[0] + dx, c[1] + dy, c[2] + dz);
-      // Two neighbouring cells can share a bucket: visit each bucket once.
-      const std::uint64_t bit = std::uint64_t(1) << (b & 63u);
-      if (seen_bits & bit) {
-        bool repeat = false;
-        for (int k = 0; k < seen_count; ++k) repeat = repeat || seen[k] == b;
-        if (repeat) continue;
+      const std::int32_t d[3] = {n % 3 - 1, (n / 3) % 3 - 1, D == 3 ? n / 9 - 1 : 0};
+      bucket[n] = grid.bucket(c[0] + d[0], c[1] + d[1], c[2] + d[2]);
+      Scalar gap2 = 0;
+      for (int k = 0; k < D; ++k) {
+        const Scalar gap = d[k] < 0 ? low[k] : (d[k] > 0 ? high[k] : Scalar(0));
+        gap2 += gap * gap;
       }
-      seen_bits |= bit;
-      seen[seen_count++] = b;
+      visit[n] = !regular || !(gap2 > r2);
+      const std::uint64_t bit = std::uint64_t(1) << (bucket[n] & 63u);
+      if (bucket_bits & bit) {
+        for (int k = 0; k < n; ++k)
+          if (bucket[k] == bucket[n]) {
+            visit[k] = visit[k] || visit[n];
+            visit[n] = false;
+            break;
+          }
+      }
+      bucket_bits |= bit;
+    }
+    for (int n = 0; n < neighbours; ++n) {
+      if (!visit[n]) continue;
+      const std::uint32_t b = bucket[n];
       const GridItem<D>* it = grid.items + grid.start[b];
       const GridItem<D>* const end = grid.items + grid.start[b + 1];
+      examined += std::uint32_t(end - it);
       for (; it != end; ++it) {
-        const std::uint32_t j = it->body;
         // An awake pair is found once, from its lower index; a sleeper never looks itself.
-        if (j == i || (j < i && it->awake)) continue;
-        // As `candidate`, from the grid's copy of body j.
-        const Scalar reach = bi.bounding_radius + it->reach;
-        if ((it->position - bi.position).squaredNorm() > reach * reach) continue;
+        if (it->key <= i) continue;
+        // As `candidate`, from the grid's copy of body j; bodies beyond the widest reach first,
+        // without reading body j (reach <= reach_max, so reach^2 <= reach_max^2).
+        const Scalar d2 = (it->position - bi.position).squaredNorm();
+        if (d2 > reach_max2) continue;
+        const std::uint32_t j = it->key & ~asleep_key;
+        const Scalar reach = bi.bounding_radius + w.bodies[j].bounding_radius;
+        if (d2 > reach * reach) continue;
         if (found < w.max_pairs) w.pairs[found] = Pair{i < j ? i : j, i < j ? j : i};
         ++found;
       }
     }
-  }
+  });
+  result.pairs_examined += examined;
   return found;
 }
 
 /// Pairs from sweep-and-prune along `WorldDef::sweep_axis`. The entries keep last step's order,
 /// so the insertion sort has little to do. Returns how many pairs were found.
 template <int D>
-std::uint32_t find_pairs_sweep(WorldData<D>& w)
+std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
 {
+  // With no body awake there is no pair; if the entries were sorted on the bodies' present
+  // places (a sweep with none awake, after which nothing moved) the sweep would not change them.
+  if (w.awake_count == 0 && w.sweep_current && w.entry_count == w.body_count) return 0;
   // Bodies added since the last sweep join at the end, in order of creation.
   for (; w.entry_count < w.body_count; ++w.entry_count)
-    w.entries[w.entry_count] = SweepEntry{0, 0, w.entry_count, 1};
+    new (&w.entries[w.entry_count]) SweepEntry{0, 0, w.entry_count, 1};
   const int axis = w.def.sweep_axis;
   Scalar widest = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
@@ -101,11 +143,35 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w)
     e.active = b.state != MotionState::asleep ? 1u : 0u;
     widest = 2 * b.bounding_radius > widest ? 2 * b.bounding_radius : widest;
   }
+  result.broad_phase_bodies += w.body_count;
   insertion_sort(w.entries, w.body_count);
+  // Nothing moves in a step without awake bodies: the order stays valid for the next.
+  w.sweep_current = w.awake_count == 0;
+  // Its overlaps are not counted in `StepResult::pairs_examined`: a counter in the sweep's inner
+  // loop costs it more than the count is worth.
   std::uint32_t found = 0;
-  sweep_active(w.entries, w.body_count, widest,
-               [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, found); });
+  sweep_active(w.entries, w.body_count, widest, [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, found); });
   return found;
+}
+
+/// Hands the broad phase's block from sweep-and-prune to the grid or back, keeping the sweep order:
+/// entry k (16 bytes at 16 k) to index k (4 bytes at 4 k) in increasing k, and back in decreasing
+/// k, so that nothing is overwritten before it is read.
+template <int D>
+void switch_broad_phase(WorldData<D>& w)
+{
+  if (!w.grid_layout) {
+    for (std::uint32_t k = 0; k < w.entry_count; ++k) {
+      const std::uint32_t body = w.entries[k].body;
+      new (&w.order[k]) std::uint32_t(body);
+    }
+  } else {
+    for (std::uint32_t k = w.entry_count; k-- > 0;) {
+      const std::uint32_t body = w.order[k];
+      new (&w.entries[k]) SweepEntry{0, 0, body, 1};
+    }
+  }
+  w.grid_layout = !w.grid_layout;
 }
 
 /// Fills the pair buffer with this step's candidate pairs, up to its capacity; the result tells
@@ -115,7 +181,16 @@ void find_pairs(WorldData<D>& w, StepResult& result)
 {
   const bool grid = w.def.broad_phase == BroadPhase::grid ||
                     (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies);
-  const std::uint32_t found = grid ? find_pairs_grid(w) : find_pairs_sweep(w);
+  std::uint32_t found = 0;
+  if (grid != w.grid_layout) switch_broad_phase(w);
+  if (grid) {
+    // The grid keeps nothing from step to step but its sizes; bodies move under the entries.
+    w.sweep_current = false;
+    // Two sleepers are never a pair.
+    if (w.awake_count > 0) found = find_pairs_grid(w, result);
+  } else {
+    found = find_pairs_sweep(w, result);
+  }
   result.pairs_found = found;
   if (found > w.max_pairs) {
     result.pairs_dropped = found - w.max_pairs;

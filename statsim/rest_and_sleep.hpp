@@ -41,10 +41,10 @@ template <int D>
 void update_radii(WorldData<D>& w)
 {
   using Vec = typename Space<D>::Vec;
-  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
     const Shape<D>& shape = w.shapes[b.shape];
-    if (!shape.statistical || b.state == MotionState::asleep) continue;
+    if (!shape.statistical) return;
     const SignatureView<D>& sig = shape.signature;
     // Spin ratio with the speed floored: a body bouncing in place has |v| near 0 one step and
     // g dt the next, and |w| L / |v| would swing its radius between the table's ends.
@@ -54,7 +54,7 @@ void update_radii(WorldData<D>& w)
     const Scalar r = collision_radius<D>(sig, v_ref, b.angular_velocity, w.def.nearest_radius);
     if (b.rest_pose == no_rest_pose && !b.pile_rest) {
       b.radius = r;
-      continue;
+      return;
     }
     const Scalar h = b.rest_pose != no_rest_pose ? sig.rest.heights[b.rest_pose] : shape.mean_rest_height;
     const Scalar blended = r + (h - r) * b.rest_blend;
@@ -64,7 +64,7 @@ void update_radii(WorldData<D>& w)
     if (b.on_ground) b.position += ground_normal(w, b) * (blended - b.radius);
     else if (b.pile_rest) b.position[Space<D>::up_axis] += blended - b.radius;
     b.radius = blended;
-  }
+  });
 }
 
 /// Resting conditions (paper 3.4): a statistical body settling on the ground picks the rest
@@ -118,9 +118,8 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
   const WorldDef<D>& def = w.def;
   const Scalar settle2 = def.settle_speed * def.settle_speed;
   const Scalar sleep2 = def.sleep_speed * def.sleep_speed;
-  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
-    if (b.state == MotionState::asleep) continue;
     const Scalar r2 = b.bounding_radius * b.bounding_radius;
     const Scalar v2 = b.linear_velocity.squaredNorm();
     // A body turning into its rest pose spins because the resting conditions make it: its
@@ -134,7 +133,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     if (!settling) {
       b.state = MotionState::moving;
       b.slow_time = 0;
-      continue;
+      return;
     }
     b.state = MotionState::settling;
     // Stillness by displacement as well as velocity: with three or more contacts the passes
@@ -155,6 +154,9 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
       // Read while the body is still settling: `hull_radius` gives an asleep body its radius.
       const Scalar above = hull_radius(w, b, ground);
       b.state = MotionState::asleep;
+      clear_bit(w.awake, i);
+      --w.awake_count;
+      set_bit(w.flagged, i);  // its contact flags stay set until the next step clears them
       b.linear_velocity = Vec::Zero();
       b.angular_velocity = Space<D>::zero_spin();
       if (b.rest_pose != no_rest_pose && b.on_ground && posed) {
@@ -170,7 +172,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
         b.rest_blend = 1;
       }
     }
-  }
+  });
 }
 
 }  // namespace detail

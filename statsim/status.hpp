@@ -70,6 +70,12 @@ struct [[nodiscard]] StepResult {
   std::uint32_t contacts = 0;        ///< body-body and body-plane contacts resolved
   std::uint32_t energy_clamps = 0;   ///< sampled responses the energy guard scaled down
   std::uint32_t statistical_responses = 0;  ///< sampled responses applied (body-plane and body-body)
+  /// Work of the step, for tests and profiling: bodies integrated (the awake ones), bodies the
+  /// broad phase read, and candidate pairs the grid examined (bounding-sphere tests;
+  /// sweep-and-prune does not count its own). A world whose bodies are all asleep does none of it.
+  std::uint32_t bodies_integrated = 0;
+  std::uint32_t broad_phase_bodies = 0;
+  std::uint32_t pairs_examined = 0;
   /// True when the step ran and nothing overflowed.
   constexpr bool ok() const { return status == Status::ok && overflow == overflow_none; }
 };

@@ -62,7 +62,10 @@ class WorldCore {
   Status configure(const WorldDef<D>& def)
   {
     const Status s = detail::check_world_def(def);
-    if (s == Status::ok) w_.def = def;
+    if (s == Status::ok) {
+      w_.def = def;
+      w_.sweep_current = false;  // the sweep axis may have changed
+    }
     return s;
   }
   const WorldDef<D>& def() const { return w_.def; }
@@ -174,6 +177,7 @@ class WorldCore {
                    ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
                    : shape.radius;
     b.bounding_radius = shape.bounding_radius;
+    w_.widest = 2 * b.bounding_radius > w_.widest ? 2 * b.bounding_radius : w_.widest;
     b.inv_mass = Scalar(1) / mass;
     b.slow_time = 0;
     b.step_start = b.position;
@@ -185,6 +189,10 @@ class WorldCore {
     b.rest_pose = no_rest_pose;
     b.pile_rest = false;
     b.rest_blend = 0;
+    if (!def.asleep) {
+      detail::set_bit(w_.awake, id);
+      ++w_.awake_count;
+    }
     ++w_.body_count;
     return {Status::ok, id};
   }
@@ -198,7 +206,7 @@ class WorldCore {
     Body<D>& b = w_.bodies[id];
     b.linear_velocity = linear;
     b.angular_velocity = angular;
-    detail::wake(b);
+    detail::wake(w_, b);
     return Status::ok;
   }
 
@@ -211,7 +219,7 @@ class WorldCore {
     Body<D>& b = w_.bodies[id];
     b.position = position;
     b.orientation = detail::normalized(orientation);
-    detail::wake(b);
+    detail::wake(w_, b);
     return Status::ok;
   }
 
@@ -229,10 +237,11 @@ class WorldCore {
     detail::StepContext ctx;
     ctx.dt = dt;
     ctx.tilted_planes = detail::any_tilted_plane(w_);
-    detail::integrate(w_, dt);
+    result.bodies_integrated = detail::integrate(w_, dt);
     detail::update_radii(w_);
-    detail::find_pairs(w_, result);
+    // Before the broad phase, which replaces last step's pairs (it does not read the flags).
     detail::forget_contacts(w_);
+    detail::find_pairs(w_, result);
     result.contacts += detail::impact_pass(w_, ctx);
     // A support pass that changed no velocity and moved nothing would be repeated exactly by
     // the next one: stop there (a resting pile needs one pass, not `support_iterations`; the
@@ -246,6 +255,7 @@ class WorldCore {
       for (int i = 0; i < w_.def.position_iterations && moves > 0; ++i) moves = detail::position_pass(w_, ctx);
     }
     detail::update_motion_states(w_, dt);
+    w_.touching_pairs = ctx.touching;
     result.energy_clamps = ctx.energy_clamps;
     result.statistical_responses = ctx.statistical_responses;
     w_.energy_clamps += ctx.energy_clamps;
@@ -320,22 +330,28 @@ class WorldCore {
   /// Storage a `World<>` hands to its core.
   struct Storage {
     Body<D>* bodies;
-    SweepEntry* entries;
+    unsigned char* broad_phase;  ///< `detail::BroadPhaseLayout<D>::bytes(max_bodies)`, aligned for 16-byte records
     Pair* pairs;
     Plane<D>* planes;
     Shape<D>* shapes;
-    std::uint32_t* grid_start;
-    detail::GridItem<D>* grid_items;
+    std::uint32_t* awake;
+    std::uint32_t* flagged;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   };
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
       : w_{s.bodies,
-           s.entries,
+           reinterpret_cast<SweepEntry*>(s.broad_phase + detail::BroadPhaseLayout<D>::order(s.max_bodies)),
+           reinterpret_cast<std::uint32_t*>(s.broad_phase + detail::BroadPhaseLayout<D>::order(s.max_bodies)),
            s.pairs,
            s.planes,
            s.shapes,
-           detail::SpatialHash<D>{s.grid_start, s.grid_items, detail::grid_buckets(s.max_bodies)},
+           detail::SpatialHash<D>{
+               reinterpret_cast<std::uint32_t*>(s.broad_phase + detail::BroadPhaseLayout<D>::start(s.max_bodies)),
+               reinterpret_cast<detail::GridItem<D>*>(s.broad_phase + detail::BroadPhaseLayout<D>::items(s.max_bodies)),
+               detail::grid_buckets(s.max_bodies)},
+           s.awake,
+           s.flagged,
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
@@ -357,12 +373,12 @@ namespace detail {
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes>
 struct WorldStorage {
   std::array<Body<D>, MaxBodies> body_store;
-  std::array<SweepEntry, MaxBodies> entry_store;
+  alignas(16) std::array<unsigned char, detail::BroadPhaseLayout<D>::bytes(MaxBodies)> broad_phase_store;
   std::array<Pair, MaxPairs> pair_store;
   std::array<Plane<D>, MaxPlanes> plane_store;
   std::array<Shape<D>, MaxShapes> shape_store;
-  std::array<std::uint32_t, detail::grid_buckets(MaxBodies) + 1> grid_start_store;
-  std::array<detail::GridItem<D>, MaxBodies> grid_item_store;
+  std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
+  std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
 };
 }  // namespace detail
 
@@ -388,11 +404,12 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   /// `construction_status()` says why.
   explicit World(const WorldDef<D>& def = {})
       : StorageBase(),
-        WorldCore<D>(typename WorldCore<D>::Storage{StorageBase::body_store.data(), StorageBase::entry_store.data(),
+        WorldCore<D>(typename WorldCore<D>::Storage{StorageBase::body_store.data(),
+                                                     StorageBase::broad_phase_store.data(),
                                                      StorageBase::pair_store.data(), StorageBase::plane_store.data(),
                                                      StorageBase::shape_store.data(),
-                                                     StorageBase::grid_start_store.data(),
-                                                     StorageBase::grid_item_store.data(), MaxBodies, MaxPairs, MaxPlanes,
+                                                     StorageBase::awake_store.data(),
+                                                     StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
                                                      MaxShapes},
                      def)
   {

@@ -12,20 +12,79 @@
 namespace statsim {
 namespace detail {
 
+/// Words of a bit set of `n` bodies.
+constexpr std::uint32_t bit_words(std::uint32_t n)
+{
+  return (n + 31) / 32;
+}
+
+/// Index of the lowest set bit of `x` (not 0).
+inline std::uint32_t lowest_bit(std::uint32_t x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+  return std::uint32_t(__builtin_ctz(x));
+#else
+  std::uint32_t i = 0;
+  while (!(x & 1u)) {
+    x >>= 1;
+    ++i;
+  }
+  return i;
+#endif
+}
+
+/// Calls `f(i)` for every body i whose bit is set in the first `bit_words(count)` words, in
+/// increasing order, at a cost of one word per 32 bodies plus the bodies set. Each word is read
+/// once, before its bodies are visited: `f` may clear the bit of the body it is given.
+template <class F>
+void for_each_set(const std::uint32_t* words, std::uint32_t count, F&& f)
+{
+  const std::uint32_t n = bit_words(count);
+  for (std::uint32_t k = 0; k < n; ++k)
+    for (std::uint32_t bits = words[k]; bits != 0; bits &= bits - 1) f(k * 32 + lowest_bit(bits));
+}
+
+inline void set_bit(std::uint32_t* words, std::uint32_t i)
+{
+  words[i / 32] |= std::uint32_t(1) << (i % 32);
+}
+inline void clear_bit(std::uint32_t* words, std::uint32_t i)
+{
+  words[i / 32] &= ~(std::uint32_t(1) << (i % 32));
+}
+
 /// A world's storage (owned by `World<>`), counts and parameters: what every phase reads.
 template <int D>
 struct WorldData {
   Body<D>* bodies;
-  SweepEntry* entries;  ///< the sweep-and-prune order of the first `entry_count` bodies
+  /// The sweep-and-prune order of the first `entry_count` bodies: in `entries` while
+  /// sweep-and-prune runs, as body indices in `order` while the grid does (`grid_layout`); the
+  /// two share their storage with the grid's (`BroadPhaseLayout`).
+  SweepEntry* entries;
+  std::uint32_t* order;
   Pair* pairs;
   Plane<D>* planes;
   Shape<D>* shapes;
   SpatialHash<D> grid;
+  /// Bit set of the bodies that are not asleep: the phases of a step walk these, so a sleeping
+  /// body costs nothing until it wakes.
+  std::uint32_t* awake;
+  /// Bit set of the bodies that fell asleep in the last step, whose `touching` and `on_ground`
+  /// may still be set: the next step clears their flags with the awake bodies' and those of the
+  /// last step's touching pairs (the only sleepers the passes mark).
+  std::uint32_t* flagged;
   std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   std::uint32_t body_count = 0, pair_count = 0, plane_count = 0, shape_count = 0;
   /// Bodies that have a sweep entry: sweep-and-prune adds the entries of newer bodies when it
   /// next runs, so the grid never touches them.
   std::uint32_t entry_count = 0;
+  std::uint32_t touching_pairs = 0;  ///< last step's touching pairs, at the front of `pairs`
+  std::uint32_t awake_count = 0;  ///< bodies not asleep
+  Scalar widest = 0;  ///< the largest bounding diameter of the bodies, m
+  /// The sweep-and-prune entries hold every body's interval, sorted, and no body has moved since:
+  /// a sweep with no awake body would change nothing and find no pair.
+  bool sweep_current = false;
+  bool grid_layout = false;  ///< the broad phase's block holds the grid (see `entries`)
   std::uint64_t step_count = 0;
   std::uint64_t energy_clamps = 0;  ///< over the world's life
   std::uint64_t statistical_responses = 0;  ///< over the world's life
@@ -62,31 +121,38 @@ Pcg32 rng_of(const WorldData<D>& w, const Body<D>& b)
 }
 
 template <int D>
-void wake(Body<D>& b)
+void wake(WorldData<D>& w, Body<D>& b)
 {
+  if (b.state == MotionState::asleep) {
+    set_bit(w.awake, std::uint32_t(&b - w.bodies));
+    ++w.awake_count;
+  }
   b.state = MotionState::moving;
   b.slow_time = 0;
   b.step_start = b.position;  // a sleeper is not integrated: this is where it started the step
 }
 
 /// Semi-implicit Euler for awake bodies: gravity and damping change the velocity, which then
-/// moves the body; orientation without trigonometry (`detail::integrate`).
+/// moves the body; orientation without trigonometry (`detail::integrate`). Returns the number of
+/// bodies integrated.
 template <int D>
-void integrate(WorldData<D>& w, Scalar dt)
+std::uint32_t integrate(WorldData<D>& w, Scalar dt)
 {
   using Vec = typename Space<D>::Vec;
   const Vec dv = w.def.gravity * dt;
   const Scalar lin_damp = Scalar(1) / (1 + dt * w.def.linear_damping);
   const Scalar ang_damp = Scalar(1) / (1 + dt * w.def.angular_damping);
-  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+  std::uint32_t count = 0;
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
-    if (b.state == MotionState::asleep) continue;
     b.step_start = b.position;
     b.linear_velocity = (b.linear_velocity + dv) * lin_damp;
     b.angular_velocity = b.angular_velocity * ang_damp;
     b.position += b.linear_velocity * dt;
     b.orientation = integrate(b.orientation, b.angular_velocity, dt);
-  }
+    ++count;
+  });
+  return count;
 }
 
 /// Adds every parameter of a world to a hash. A new `WorldDef` field belongs here too.
@@ -188,7 +254,7 @@ std::uint64_t state_hash(const WorldData<D>& w)
   // The sweep-and-prune order breaks ties between equal interval starts, so it decides the order
   // of pairs, and with it of contacts.
   h.add(w.entry_count);
-  for (std::uint32_t i = 0; i < w.entry_count; ++i) h.add(w.entries[i].body);
+  for (std::uint32_t i = 0; i < w.entry_count; ++i) h.add(w.grid_layout ? w.order[i] : w.entries[i].body);
   return h.value;
 }
 
