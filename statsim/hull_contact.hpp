@@ -93,35 +93,6 @@ inline Scalar support_along(const ContactView<2>& c, const Vector2& u)
   return um * ((1 - t) * c.support[k] + t * c.support[k + 1]);
 }
 
-/// The support in body direction u (unit) toward a plane: the map's value, or the bound through
-/// the stored face nearest u where that is less. s is sublinear (s(x + y) <= s(x) + s(y), and
-/// s(c x) = c s(x) for c >= 0), so with c = u.f > 0 and r = u - c f,
-///     s(u) <= c o + s(r) <= c o + map(r),
-/// o the face's offset: never below the hull, and exact at the face's normal (r = 0). There the
-/// map alone reads above the hull: a face normal is a crease of s, and the bilinear interpolation
-/// across it lies above s by up to the cell's size times the face's extent. A body resting on a
-/// face has the plane's normal along that face's, so this is where a body settles.
-template <int D>
-Scalar plane_support(const ContactView<D>& c, const typename Space<D>::Vec& u)
-{
-  using Vec = typename Space<D>::Vec;
-  const Scalar map = support_along(c, u);
-  Scalar best = 0;
-  const Scalar* nearest = nullptr;
-  for (std::uint32_t i = 0; i < c.face_count; ++i) {
-    const Scalar* f = c.faces + i * face_values(D);
-    const Scalar along = Vec(Eigen::Map<const Vec>(f)).dot(u);
-    if (along > best) {
-      best = along;
-      nearest = f;
-    }
-  }
-  if (!nearest) return map;
-  const Vec normal = Eigen::Map<const Vec>(nearest);
-  const Scalar bound = best * nearest[D] + support_along(c, Vec(u - best * normal));
-  return bound < map ? bound : map;
-}
-
 /// True when body-body contacts of this shape can use its hull: a statistical shape whose table
 /// has body-body data, or a plain sphere.
 template <int D>
@@ -397,7 +368,7 @@ bool support_overhang(const Shape<D>& slo, const Body<D>& lo, const Shape<D>& su
 
 /// The radius a body keeps from a plane of normal `n`: its collision radius, or, for a
 /// settling body with a hull (`BodyContacts::hulls`), at least its hull's support toward the
-/// plane (`plane_support`), so that a body resting out of its rest poses (propped by others) does not sink its
+/// plane, so that a body resting out of its rest poses (propped by others) does not sink its
 /// hull into the ground or a wall.
 template <int D>
 Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
@@ -406,7 +377,7 @@ Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
   if (w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling || !s.statistical ||
       !s.signature.contact.present())
     return b.radius;
-  const Scalar hull = plane_support(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
+  const Scalar hull = support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
   return hull > b.radius ? hull : b.radius;
 }
 

@@ -151,8 +151,6 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (posed || wedged);
     b.slow_time = still ? b.slow_time + dt : 0;
     if (still && b.slow_time >= (posed ? def.sleep_time : 3 * def.sleep_time)) {
-      // Read while the body is still settling: `hull_radius` gives an asleep body its radius.
-      const Scalar above = hull_radius(w, b, ground);
       b.state = MotionState::asleep;
       clear_bit(w.awake, i);
       --w.awake_count;
@@ -165,6 +163,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
         // The centre stood `hull_radius` above the ground (the collision radius, or the hull's
         // support where that is more): it ends at the pose's height above it.
         const SignatureView<D>& sig = w.shapes[b.shape].signature;
+        const Scalar above = hull_radius(w, b, ground);
         b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
         const Scalar h = sig.rest.heights[b.rest_pose];
         b.position += ground * (h - above);

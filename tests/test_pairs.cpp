@@ -5,7 +5,6 @@
 #include "ref3d/model.hpp"
 #include "ref3d/pairs.hpp"
 
-#include "statsim/hull_contact.hpp"
 #include "support/temp_dir.hpp"
 
 #include <doctest/doctest.h>
@@ -148,42 +147,6 @@ TEST_CASE("the support map never falls below the hull and stays within its bound
   CHECK(e.min >= -1e-12);
   CHECK(e.max > 0);
   CHECK(e.max <= t.error_bound(tri));
-}
-
-TEST_CASE("toward a plane the runtime reads the bunny's hull exactly at its faces, never below the hull")
-{
-  // A face normal is a crease of the support function: the map's interpolation across it reads
-  // above the hull there, which is where a body rests on a plane; statsim::detail::plane_support
-  // bounds it through the face instead.
-  const ShapeModel m = load_shape_model("bunny", "", 1000.0);
-  const SupportMap3 map = SupportMap3::build(m.hull, 17);
-  const std::vector<Eigen::Vector3d> normals = faces_by_area(m);
-  const std::vector<double> offsets = face_offsets(m, normals);
-  std::vector<float> values, faces;
-  for (double v : map.values) values.push_back(static_cast<float>(v));
-  const std::size_t k = std::min<std::size_t>(16, normals.size());
-  for (std::size_t i = 0; i < k; ++i)
-    faces.insert(faces.end(), {static_cast<float>(normals[i].x()), static_cast<float>(normals[i].y()),
-                               static_cast<float>(normals[i].z()), static_cast<float>(offsets[i]), 1.0f});
-  statsim::ContactView<3> c;
-  c.support_size = 17;
-  c.support = statsim::ValuesView{values.data(), nullptr, 1, 0};
-  c.faces = faces.data();
-  c.face_count = static_cast<std::uint32_t>(k);
-  double worst_map = 0;
-  for (std::size_t i = 0; i < k; ++i) {
-    CAPTURE(i);
-    const statsim::Vector3 n = normals[i].cast<float>();
-    worst_map = std::max(worst_map, double(statsim::detail::support_along(c, n)) - offsets[i]);
-    CHECK(double(statsim::detail::plane_support(c, n)) == doctest::Approx(offsets[i]).epsilon(1e-5));
-  }
-  CHECK(worst_map > 1e-3);  // the map alone: more than a millimetre above at some face
-  for (const Eigen::Vector3d& u : directions(20000)) {
-    const statsim::Vector3 uf = u.cast<float>();
-    const double p = double(statsim::detail::plane_support(c, uf));
-    CHECK(p >= support(m.hull, u) - 1e-5);
-    CHECK(p <= double(statsim::detail::support_along(c, uf)));
-  }
 }
 
 TEST_CASE("the candidate-normal estimate is the closed form for aligned cubes and bounds rotated ones")
