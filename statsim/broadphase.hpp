@@ -14,7 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <new>
+#include <new>  // placement new: objects begun in the world's own storage block, nothing allocated
 
 namespace statsim {
 

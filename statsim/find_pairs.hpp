@@ -8,7 +8,7 @@
 
 #include <cmath>
 #include <cstdint>
-#include <new>
+#include <new>  // placement new: objects begun in the world's own storage block, nothing allocated
 
 namespace statsim {
 namespace detail {

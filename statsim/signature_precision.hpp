@@ -6,7 +6,49 @@
 
 #include "statsim/signature.hpp"
 
+#include <cstddef>
+#include <cstdint>
+
 namespace statsim {
+
+namespace detail {
+/// Nearest integer, ties to even (what std::nearbyint gives in the default rounding mode), for
+/// |x| < 2^62; constexpr where std::nearbyint is not.
+constexpr double round_half_even(double x)
+{
+  const double t = double(static_cast<long long>(x));  // truncated toward zero
+  const double r = x - t;
+  const bool odd = static_cast<long long>(t) % 2 != 0;
+  if (r > 0.5 || (r == 0.5 && odd)) return t + 1;
+  if (r < -0.5 || (r == -0.5 && odd)) return t - 1;
+  return t;
+}
+}  // namespace detail
+
+/// The 16-bit rule, the one every part of statsim uses (`statsim gather --precision i16`, the
+/// firmware, JSON tables): offset = mid-range, scale = range / 65534 (1 for a constant table),
+/// q = the nearest integer, ties to even, of (value - offset) / scale in double precision,
+/// clamped to +-32767. Works on `n` values at `values`; constexpr, so a table can be quantised at
+/// compile time and only its 16-bit form kept in flash.
+constexpr void quantize16(const Scalar* values, std::size_t n, Scalar& scale, Scalar& offset, std::int16_t* q)
+{
+  if (n == 0) {
+    scale = 1;
+    offset = 0;
+    return;
+  }
+  Scalar lo = values[0], hi = values[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = values[i] < lo ? values[i] : lo;
+    hi = values[i] > hi ? values[i] : hi;
+  }
+  offset = Scalar(0.5) * (lo + hi);
+  scale = hi > lo ? (hi - lo) / Scalar(65534) : Scalar(1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = detail::round_half_even((double(values[i]) - double(offset)) / double(scale));
+    q[i] = static_cast<std::int16_t>(r < -32767 ? -32767 : r > 32767 ? 32767 : r);
+  }
+}
 
 /// The 16-bit form of a float signature, by the rule of `quantize16`: everything but the response
 /// tables is copied (body-body data too, in the precision it has). `inline constexpr auto t16 = statsim::quantize16(tables::box);` keeps only
