@@ -87,6 +87,8 @@ struct Setup3 {
   /// statsim: plain spheres of the table's zero-spin radius with this material instead of the
   /// statistical shape (the particle model).
   bool particle = false;
+  /// statsim: where bodies touch (`StressOptions::hull_contacts`).
+  BodyContacts body_contacts = BodyContacts::collision_spheres;
 };
 
 // statsim 3D: the benchmark's statsim world has one ground plane, gravity and the table's shape;
@@ -102,6 +104,7 @@ public:
     if (states.size() > Cap) throw std::runtime_error("stress: statsim world too small");
     WorldDef3 def;
     def.gravity = setup.gravity.cast<Scalar>();
+    def.body_contacts = setup.body_contacts;
     world_ = std::make_unique<WorldT>(def);
     Added<ShapeId> shape;
     if (setup.particle) {
@@ -177,14 +180,18 @@ public:
   }
   double overlap() const override
   {
-    // Every pair of collision spheres, asleep or not (the broad phase skips sleeping pairs): a
-    // sweep along x.
+    // Every pair, asleep or not (the broad phase skips sleeping pairs): a sweep along x. With
+    // collision spheres the overlap is that of the spheres over the sum of their radii; with
+    // hull contacts that of the hulls over the separation at which the runtime's own rule lets
+    // them touch (the closest hull candidate times its packing ratio), as tests/test_hull_contacts does.
+    const bool hulls = world_->def().body_contacts == BodyContacts::hulls;
     const std::uint32_t n = world_->body_count();
     std::vector<std::pair<double, std::uint32_t>> xs(n);
     double rmax = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
-      xs[i] = {double(world_->body(i).position.x()), i};
-      rmax = std::max(rmax, double(world_->body(i).radius));
+      const Body<3>& b = world_->body(i);
+      xs[i] = {double(b.position.x()), i};
+      rmax = std::max({rmax, double(b.radius), hulls ? double(b.bounding_radius) : 0.0});
     }
     std::sort(xs.begin(), xs.end());
     double deepest = 0;
@@ -192,11 +199,30 @@ public:
       for (std::uint32_t j = i + 1; j < n && xs[j].first - xs[i].first < 2 * rmax; ++j) {
         const Body<3>& a = world_->body(xs[i].second);
         const Body<3>& b = world_->body(xs[j].second);
-        const double sum = double(a.radius) + double(b.radius);
-        const double d = double((a.position - b.position).norm());
-        deepest = std::max(deepest, (sum - d) / sum);
+        deepest = std::max(deepest, hulls ? hull_overlap(a, b) : sphere_overlap(a, b));
       }
     return deepest;
+  }
+  static double sphere_overlap(const Body<3>& a, const Body<3>& b)
+  {
+    const double sum = double(a.radius) + double(b.radius);
+    const double d = double((a.position - b.position).norm());
+    return (sum - d) / sum;
+  }
+  double hull_overlap(const Body<3>& a, const Body<3>& b) const
+  {
+    const Shape<3>& sa = world_->shape(ShapeId(a.shape));
+    const Shape<3>& sb = world_->shape(ShapeId(b.shape));
+    const Vector3 d = b.position - a.position;
+    const Scalar dist = d.norm();
+    if (!(dist > 0)) return 1;
+    const Vector3 e = d / dist;
+    const Scalar packing = std::max(sa.largest_packing, sb.largest_packing);
+    const std::uint32_t k = detail::find_hull_witness(sa, a, sb, b, e, dist, packing);
+    if (k == detail::no_witness) return 0;
+    const detail::HullCandidate<3> h = detail::hull_candidate(sa, a, sb, b, e, k);
+    const Scalar reach = (k == 0 ? detail::pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
+    return double((reach - d.dot(h.normal)) / reach);
   }
   double lowest(std::size_t i) const override
   {
@@ -316,9 +342,11 @@ private:
 class StatsimSim2 final : public Sim2 {
 public:
   /// The ground's normal is (0, 1), or with `slope` (rad) (sin, cos): falling along +x.
-  explicit StatsimSim2(const std::vector<scenes::BodyState2>& states, double slope = 0)
+  StatsimSim2(const std::vector<scenes::BodyState2>& states, BodyContacts contacts, double slope = 0)
   {
-    world_ = std::make_unique<World2<256, 4, 256 * 16, 2>>();
+    WorldDef2 def;
+    def.body_contacts = contacts;
+    world_ = std::make_unique<World2<256, 4, 256 * 16, 2>>(def);
     const SignatureView<2> sig = tables::square2d.view();
     const auto shape = world_->add_shape(sig);
     const Vector2 normal = slope == 0 ? Vector2(0, 1) : Vector2(float(std::sin(slope)), float(std::cos(slope)));
@@ -400,7 +428,16 @@ public:
   std::unique_ptr<bench::Sim> sim3(const std::string& method, const Setup3& setup,
                                    const std::vector<scenes::BodyState3>& states, double dt) const
   {
-    return make_sim3(body_, shapes_, method, setup, states, dt);
+    return make_sim3(body_, shapes_, method, with_contacts(setup), states, dt);
+  }
+  Setup3 with_contacts(Setup3 setup) const
+  {
+    setup.body_contacts = contacts();
+    return setup;
+  }
+  BodyContacts contacts() const
+  {
+    return opt_.hull_contacts ? BodyContacts::hulls : BodyContacts::collision_spheres;
   }
 
 private:
@@ -479,7 +516,7 @@ void Matrix::fast_impact()
                                          double(tables::square2d.material.restitution),
                                          double(tables::square2d.material.friction));
       else
-        sim = std::make_unique<StatsimSim2>(states2);
+        sim = std::make_unique<StatsimSim2>(states2, contacts());
       double pen = 0;
       std::vector<bool> through(states2.size(), false);
       for (int k = 0; k < steps; ++k) {
@@ -558,7 +595,9 @@ void Matrix::deep_pile()
     const bool stat = m == "statistical";
     const std::string criterion =
         fmt("after 20 s: asleep >= 95%%, kinetic energy <= %.0e J per body, ", ke_per_body) +
-        (stat ? std::string("max sphere overlap <= 20% of the radius sum (each second of the last 5 s)")
+        (stat ? std::string(opt_.hull_contacts ? "max hull overlap <= 20% of the separation the hulls touch at"
+                                                : "max sphere overlap <= 20% of the radius sum") +
+                     " (each second of the last 5 s)"
               : fmt("max contact penetration <= 0.2 R = %.1f cm (each second of the last 5 s)", 20 * R()));
     const Clock::time_point t0 = Clock::now();
     auto sim = sim3(m, setup, scene.bodies, dt);
@@ -590,7 +629,9 @@ void Matrix::deep_pile()
     const double frac = double(asleep) / double(sim->body_count());
     const double ms = 1e3 * step_s / std::max(done, 1);
     std::string figure = fmt("KE %.3g J (%.2g J/body), asleep %.1f%%, ", ke, ke / double(sim->body_count()), 100 * frac) +
-                         (stat ? fmt("max overlap %.1f%% of radius sum (whole run %.1f%%)", 100 * overlap,
+                         (stat ? fmt(opt_.hull_contacts ? "max overlap %.1f%% of the hulls' reach (whole run %.1f%%)"
+                                                       : "max overlap %.1f%% of radius sum (whole run %.1f%%)",
+                                     100 * overlap,
                                      100 * overlap_all)
                                : fmt("max penetration %.2f cm (whole run %.2f cm)", 100 * overlap,
                                      100 * overlap_all)) +
@@ -980,7 +1021,7 @@ void Matrix::slopes()
                                          double(tables::square2d.material.restitution),
                                          double(tables::square2d.material.friction), a);
       else
-        sim = std::make_unique<StatsimSim2>(states2, a);
+        sim = std::make_unique<StatsimSim2>(states2, contacts(), a);
       return run_slope(
           states2.size(), frame, after, r2,
           [&]() {
@@ -1015,7 +1056,7 @@ void Matrix::long_run()
   double sleeper_drift = 0, creep = 0, ms = 0;
   std::size_t awake_end = 0;
   for (int run = 0; run < 2; ++run) {
-    StatsimSim3<1024> sim(Setup3{}, scene.bodies, dt);
+    StatsimSim3<1024> sim(with_contacts(Setup3{}), scene.bodies, dt);
     std::vector<Eigen::Vector3d> at_snap;
     std::vector<bool> slept(sim.body_count(), false);
     const Clock::time_point t0 = Clock::now();
@@ -1232,6 +1273,8 @@ void register_stress_commands(CLI::App& app)
   cmd->add_option("--budget", opts->budget_s, "Wall-clock seconds one Bullet cell of the pile or energy scene may take")
       ->capture_default_str();
   cmd->add_option("--meshes", opts->meshes_dir, "Directory of bunny.obj, bunny_low.obj, bunny_spheres7.txt");
+  cmd->add_flag("--hull-contacts", opts->hull_contacts,
+                "statsim's bodies touch at their hulls (WorldDef::body_contacts = hulls), not their collision spheres");
   cmd->callback([opts, json]() {
     const std::vector<StressCell> cells = run_stress(*opts);
     std::cout << stress_markdown(cells);
