@@ -15,6 +15,7 @@
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
+#include "tables/box.hpp"
 #include "tables/bunny.hpp"
 #include "tables/square2d.hpp"
 
@@ -89,6 +90,10 @@ struct Setup3 {
   bool particle = false;
   /// statsim: where bodies touch (`StressOptions::hull_contacts`).
   BodyContacts body_contacts = BodyContacts::collision_spheres;
+  /// statsim: the table; null: the bunny's. Bullet takes the `Body3` it is given.
+  const SignatureView<3>* signature = nullptr;
+  /// Body i has the shape's mass (and inertia) times `mass_scale[i]`; empty: all 1.
+  std::vector<double> mass_scale;
 };
 
 // statsim 3D: the benchmark's statsim world has one ground plane, gravity and the table's shape;
@@ -99,7 +104,8 @@ public:
   using WorldT = World3<Cap, 8, Cap * 32, 2>;
 
   StatsimSim3(const Setup3& setup, const std::vector<scenes::BodyState3>& states, double dt)
-      : sig_(tables::bunny.view()), particle_(setup.particle), dt_(static_cast<Scalar>(dt))
+      : sig_(setup.signature ? *setup.signature : tables::bunny.view()), particle_(setup.particle),
+        dt_(static_cast<Scalar>(dt))
   {
     if (states.size() > Cap) throw std::runtime_error("stress: statsim world too small");
     WorldDef3 def;
@@ -123,14 +129,15 @@ public:
       if (!added.ok()) throw std::runtime_error(std::string("statsim add_plane: ") + to_string(added.status));
     }
     mass_ = static_cast<double>(sig_.mass);
-    for (const scenes::BodyState3& s : states) {
+    for (std::size_t i = 0; i < states.size(); ++i) {
+      const scenes::BodyState3& s = states[i];
       BodyDef3 b;
       b.position = s.position.cast<Scalar>();
       b.orientation = s.orientation.cast<Scalar>().normalized();
       b.linear_velocity = s.linear_velocity.cast<Scalar>();
       b.angular_velocity = s.angular_velocity.cast<Scalar>();
       b.shape = shape.id;
-      b.mass = static_cast<Scalar>(mass_);
+      b.mass = static_cast<Scalar>(mass_ * (setup.mass_scale.empty() ? 1.0 : setup.mass_scale[i]));
       const Added<BodyId> added = world_->add_body(b);
       if (!added.ok()) throw std::runtime_error(std::string("statsim add_body: ") + to_string(added.status));
     }
@@ -261,7 +268,24 @@ std::unique_ptr<bench::Sim> make_sim3(const Body3& body, const std::shared_ptr<b
   // Bullet's default, with which the stress figures have been recorded (the benchmark skips the
   // AABBs of sleeping bodies, which changes the broad phase's order of pairs).
   s.update_all_aabbs = true;
-  return bench::make_bullet(shapes, method, s, states, dt);
+  if (setup.mass_scale.empty()) return bench::make_bullet(shapes, method, s, states, dt);
+  // One kind of body per mass scale: the same shape, mass and inertia scaled together.
+  std::vector<std::shared_ptr<bench::BulletShapes>> kinds;
+  std::vector<double> scales;
+  std::vector<int> of_body;
+  for (const double scale : setup.mass_scale) {
+    auto at = std::find(scales.begin(), scales.end(), scale);
+    if (at == scales.end()) {
+      Body3 scaled = body;
+      scaled.mass *= scale;
+      scaled.inertia *= scale;
+      kinds.push_back(scale == 1.0 ? shapes : bench::make_bullet_shapes(scaled));
+      scales.push_back(scale);
+      at = scales.end() - 1;
+    }
+    of_body.push_back(static_cast<int>(at - scales.begin()));
+  }
+  return bench::make_bullet_mixed(kinds, of_body, method, s, states, dt);
 }
 
 // ---- 2D: Box2D polygon and statsim ------------------------------------------------------------------
@@ -385,8 +409,8 @@ private:
 // ---- the matrix -------------------------------------------------------------------------------------
 class Matrix {
 public:
-  Matrix(const StressOptions& o, Body3 body)
-      : opt_(o), body_(std::move(body)), shapes_(bench::make_bullet_shapes(body_))
+  Matrix(const StressOptions& o, Body3 body, std::string meshes_dir)
+      : opt_(o), body_(std::move(body)), shapes_(bench::make_bullet_shapes(body_)), dir_(std::move(meshes_dir))
   {
   }
 
@@ -424,6 +448,8 @@ public:
   void long_run();
   void bad_input();
   void slopes();
+  void small_time_step();
+  void mass_ratio();
 
   std::unique_ptr<bench::Sim> sim3(const std::string& method, const Setup3& setup,
                                    const std::vector<scenes::BodyState3>& states, double dt) const
@@ -444,6 +470,7 @@ private:
   StressOptions opt_;
   Body3 body_;
   std::shared_ptr<bench::BulletShapes> shapes_;
+  std::string dir_;
   std::vector<StressCell> cells_;
 };
 
@@ -1101,6 +1128,102 @@ void Matrix::long_run()
       "no non-finite state, bodies asleep since 60 s moved <= 1e-6 m, equal final state hash on two runs");
 }
 
+// 9. small time steps ----------------------------------------------------------------------------------
+// The 50-bunny drop of the large-step scene at 240 and 1000 Hz: what depends on dt (sleep by the
+// distance moved in a step, thresholds against |g| dt, the shock pass's corrections) must still
+// bring the bodies to rest, in the ground's reach.
+void Matrix::small_time_step()
+{
+  scenes::DropOptions o;
+  o.count = 50;
+  o.bounding_radius = R();
+  const scenes::DropScene3 scene = scenes::drop_scene3(o);
+  for (const double hz : {240.0, 1000.0}) {
+    const double dt = 1 / hz, T = 10;
+    const long steps = std::lround(T / dt);
+    const std::string name = fmt("small dt 1/%.0f, 50-bunny drop, 10 s", hz);
+    const std::string criterion = fmt("lost = 0, asleep >= 95%% at the end, deepest point of the method's "
+                                      "geometry below the ground <= 0.25 R (%.1f cm) after each step",
+                                      25 * R());
+    for (const std::string& m : methods3()) {
+      const Clock::time_point t0 = Clock::now();
+      auto sim = sim3(m, Setup3{}, scene.bodies, dt);
+      double pen = 0;
+      long done = 0;
+      for (; done < steps; ++done) {
+        sim->step();
+        for (std::size_t i = 0; i < sim->body_count(); ++i) pen = std::max(pen, -sim->lowest(i));
+        if (m != "statistical" && seconds_since(t0) > budget()) {
+          ++done;
+          break;
+        }
+      }
+      int lost = 0;
+      for (std::size_t i = 0; i < sim->body_count(); ++i) {
+        const Eigen::Vector3d x = sim->body_state(i).position;
+        lost += !finite3(x) || x.z() < -R() || std::fabs(x.x()) > 50 || std::fabs(x.y()) > 50;
+      }
+      const double asleep = double(sim->asleep()) / double(sim->body_count());
+      std::string figure = fmt("lost %d/50, asleep %.0f%%, deepest %.2f cm", lost, 100 * asleep, 100 * pen);
+      bool pass = lost == 0 && asleep >= 0.95 && pen <= 0.25 * R();
+      if (done < steps) {
+        figure += fmt("; stopped at %.1f s simulated (budget %.0f s wall)", double(done) * dt, budget());
+        pass = false;
+      }
+      add(name, m, pass, figure, criterion);
+    }
+  }
+}
+
+// 10. mass ratio ---------------------------------------------------------------------------------------
+// A column of three cubes of 0.2 m placed face to face on the ground, the top one 1000 times as
+// heavy as the two below: it must stand as the same column of equal masses does (with each
+// method's own idea of how tall that is), asleep, the bottom cube not driven into the ground.
+void Matrix::mass_ratio()
+{
+  const Body3 box = bench::load_body3("box", dir_);
+  const std::shared_ptr<bench::BulletShapes> shapes = bench::make_bullet_shapes(box);
+  const SignatureView<3> sig = tables::box.view();
+  const double half = box.boxes.at(0).half_extents.z(), ratio = 1000, dt = 1.0 / 60, T = 10;
+  const int n = 3;
+  std::vector<scenes::BodyState3> states(n);
+  for (int i = 0; i < n; ++i) states[i].position = Eigen::Vector3d(0, 0, half * (2 * i + 1));
+  const std::string name = fmt("mass ratio %.0f, column of 3 cubes", ratio);
+  const std::string criterion = fmt("after %.0f s: top within 2%% of its height with equal masses, all asleep, "
+                                    "bottom centre >= 0.5 half side above the ground",
+                                    T);
+  for (const std::string& m : methods3()) {
+    double top[2] = {0, 0}, bottom = 0;
+    std::size_t asleep = 0;
+    bool finite = true;
+    for (int r = 0; r < 2; ++r) {
+      Setup3 setup;
+      setup.signature = &sig;
+      setup.mass_scale = {1, 1, r == 1 ? ratio : 1};
+      std::unique_ptr<bench::Sim> sim;
+      try {
+        sim = make_sim3(box, shapes, m, with_contacts(setup), states, dt);
+      } catch (const std::runtime_error&) {
+        break;  // the box has no such Bullet representation
+      }
+      for (long k = 0; k < std::lround(T / dt); ++k) sim->step();
+      for (int i = 0; i < n; ++i) finite = finite && finite3(sim->body_state(std::size_t(i)).position);
+      top[r] = sim->body_state(n - 1).position.z();
+      if (r == 1) {
+        bottom = sim->body_state(0).position.z();
+        asleep = sim->asleep();
+      }
+    }
+    if (top[0] == 0) continue;
+    const bool pass = finite && std::fabs(top[1] - top[0]) <= 0.02 * top[0] && asleep == std::size_t(n) &&
+                      bottom >= 0.5 * half;
+    add(name, m, pass,
+        fmt("top %.3f m (equal masses %.3f m, %+.1f%%), bottom %.3f m, asleep %zu/%d%s", top[1], top[0],
+            100 * (top[1] / top[0] - 1), bottom, asleep, n, finite ? "" : ", NON-FINITE"),
+        criterion);
+  }
+}
+
 // 7. bad input -----------------------------------------------------------------------------------------
 template <int D>
 void bad_input_dim(Matrix& mx, const SignatureView<D>& sig, const char* method)
@@ -1222,12 +1345,13 @@ std::vector<StressCell> run_stress(const StressOptions& options)
       {"bad-input", &Matrix::bad_input}, {"fast-impact", &Matrix::fast_impact},
       {"large-dt", &Matrix::large_time_step}, {"out-of-range", &Matrix::out_of_range},
       {"energy", &Matrix::energy}, {"deep-pile", &Matrix::deep_pile},
-      {"long-run", &Matrix::long_run}, {"slopes", &Matrix::slopes}};
+      {"long-run", &Matrix::long_run}, {"slopes", &Matrix::slopes},
+      {"small-dt", &Matrix::small_time_step}, {"mass-ratio", &Matrix::mass_ratio}};
   for (const auto& name : options.scenes)
     if (std::none_of(scenes.begin(), scenes.end(), [&name](const auto& s) { return s.first == name; }))
       throw std::invalid_argument("unknown scene '" + name + "' (bad-input, fast-impact, large-dt, out-of-range, "
-                                  "energy, deep-pile, long-run, slopes)");
-  Matrix mx(options, bench::load_body3("bunny", dir));
+                                  "energy, deep-pile, long-run, slopes, small-dt, mass-ratio)");
+  Matrix mx(options, bench::load_body3("bunny", dir), dir);
   for (const auto& s : scenes)
     if (options.scenes.empty() ||
         std::find(options.scenes.begin(), options.scenes.end(), s.first) != options.scenes.end())
@@ -1266,7 +1390,7 @@ void register_stress_commands(CLI::App& app)
       ->delimiter(',');
   cmd->add_option("--scenes", opts->scenes,
                   "Scenes (default all): bad-input, fast-impact, large-dt, out-of-range, energy, deep-pile, long-run, "
-                  "slopes")
+                  "slopes, small-dt, mass-ratio")
       ->delimiter(',');
   cmd->add_option("--json", *json, "Write the cells as JSON to FILE");
   cmd->add_flag("--quick", opts->quick, "Smaller scenes: 1,000-bunny pile, 2,000 energy steps, 120 s long run, 36 bunnies per slope");
