@@ -198,7 +198,7 @@ public:
     for (std::uint32_t i = 0; i < n; ++i) {
       const Body<3>& b = world_->body(i);
       xs[i] = {double(b.position.x()), i};
-      rmax = std::max({rmax, double(b.radius), hulls ? double(b.bounding_radius) : 0.0});
+      rmax = std::max({rmax, double(b.radius), hulls ? double(world_->shape(ShapeId(b.shape)).bounding_radius) : 0.0});
     }
     std::sort(xs.begin(), xs.end());
     double deepest = 0;
