@@ -23,6 +23,7 @@
 /// Sleeping bodies are not integrated and act as static supports until hit harder than
 /// `wake_speed`.
 
+#include "statsim/body_ops.hpp"
 #include "statsim/contact_solver.hpp"
 #include "statsim/find_pairs.hpp"
 #include "statsim/rest_and_sleep.hpp"
@@ -160,68 +161,41 @@ class WorldCore {
     const Status s = detail::check_state<D>(def.position, def.orientation, def.linear_velocity, def.angular_velocity);
     if (s != Status::ok) return {s, 0};
     if (!owns(def.shape)) return {Status::invalid_shape, 0};
-    const Shape<D>& shape = w_.shapes[def.shape.index];
-    const Scalar mass = def.mass == 0 ? shape.mass : def.mass;
-    if (!detail::finite(mass)) return {Status::non_finite, 0};
-    if (!(mass > 0)) return {Status::invalid_mass, 0};
-    if (mass < limits::min_mass || mass > limits::max_mass) return {Status::out_of_range, 0};
-    if (w_.body_count == w_.max_bodies) return {Status::capacity_exceeded, 0};
-
-    const BodyId id = w_.body_count;
-    Body<D>& b = w_.bodies[id];
-    b.position = def.position;
-    b.orientation = detail::normalized(def.orientation);
-    b.linear_velocity = def.asleep ? Vec::Zero() : def.linear_velocity;
-    b.angular_velocity = def.asleep ? Space<D>::zero_spin() : def.angular_velocity;
-    b.radius = shape.statistical
-                   ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
-                   : shape.radius;
-    b.bounding_radius = shape.bounding_radius;
-    w_.widest = 2 * b.bounding_radius > w_.widest ? 2 * b.bounding_radius : w_.widest;
-    b.inv_mass = Scalar(1) / mass;
-    b.slow_time = 0;
-    b.step_start = b.position;
-    b.rng_state = Pcg32(w_.def.seed, body_stream(w_.def.seed, id)).state();
-    b.shape = def.shape.index;
-    b.state = def.asleep ? MotionState::asleep : MotionState::moving;
-    b.touching = false;
-    b.on_ground = false;
-    b.rest_pose = no_rest_pose;
-    b.pile_rest = false;
-    b.rest_blend = 0;
-    if (!def.asleep) {
-      detail::set_bit(w_.awake, id);
-      ++w_.awake_count;
-    }
-    ++w_.body_count;
-    return {Status::ok, id};
+    return detail::add_body(w_, def);
   }
 
-  /// Sets a body's velocities and wakes it.
+  /// Sets a body's velocities (m/s, rad/s) and wakes it. `invalid_body`, `non_finite`,
+  /// `out_of_range` (beyond `limits::speed`, `limits::spin`).
   Status set_velocity(BodyId id, const Vec& linear, const Spin& angular)
   {
-    if (id >= w_.body_count) return Status::invalid_body;
-    if (!detail::finite(linear) || !detail::finite(angular)) return Status::non_finite;
-    if (!detail::within(linear, limits::speed) || !detail::within(angular, limits::spin)) return Status::out_of_range;
-    Body<D>& b = w_.bodies[id];
-    b.linear_velocity = linear;
-    b.angular_velocity = angular;
-    detail::wake(w_, b);
-    return Status::ok;
+    const std::uint32_t slot = detail::find_slot(w_, id);
+    return slot == detail::no_slot ? Status::invalid_body : detail::set_velocities(w_, slot, linear, angular);
   }
-
-  /// Moves a body and wakes it.
+  /// Moves a body (m; a unit orientation) and wakes it. `invalid_body`, or as `add_body`.
   Status set_transform(BodyId id, const Vec& position, const Rot& orientation)
   {
-    if (id >= w_.body_count) return Status::invalid_body;
-    const Status s = detail::check_state<D>(position, orientation, Vec::Zero(), Space<D>::zero_spin());
-    if (s != Status::ok) return s;
-    Body<D>& b = w_.bodies[id];
-    b.position = position;
-    b.orientation = detail::normalized(orientation);
-    detail::wake(w_, b);
-    return Status::ok;
+    return detail::set_transform(w_, id, position, orientation);
   }
+  /// Adds `impulse` (N s, world frame) at `point` (m, world): the body's velocity changes by
+  /// impulse / m and its angular velocity by I^-1 ((point - centre) x impulse), I its inertia
+  /// (a table's `unit_inertia` times m, or 2/5 m r^2 for a sphere, 1/2 m r^2 for a 2D disc).
+  /// Wakes the body. `invalid_body`, `non_finite`, `out_of_range` (a point beyond
+  /// `limits::coordinate`, or velocities beyond `limits::speed` / `limits::spin` after it).
+  Status apply_impulse(BodyId id, const Vec& impulse, const Vec& point)
+  {
+    return detail::apply_impulse(w_, id, impulse, point);
+  }
+  /// Adds an angular impulse (N m s, world frame; 2D: counter-clockwise): the angular velocity
+  /// changes by I^-1 impulse. Wakes the body. Statuses as `apply_impulse`.
+  Status apply_angular_impulse(BodyId id, const Spin& impulse)
+  {
+    return detail::apply_angular_impulse(w_, id, impulse);
+  }
+  /// Wakes a body (an awake one starts its `sleep_time` again). `invalid_body`.
+  Status wake(BodyId id) { return detail::wake_body(w_, id); }
+  /// Puts a body to sleep where it is: its velocities become 0 and it is a static support until
+  /// hit faster than `wake_speed`, woken or moved. `ok` also for a sleeping body; `invalid_body`.
+  Status sleep(BodyId id) { return detail::sleep_body(w_, id); }
 
   /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` (not
   /// `out_of_range`) if dt is not finite and positive or exceeds `limits::time_step` (1 s); then
