@@ -25,6 +25,7 @@
 
 #include "statsim/body_ops.hpp"
 #include "statsim/contact_solver.hpp"
+#include "statsim/events.hpp"
 #include "statsim/find_pairs.hpp"
 #include "statsim/rest_and_sleep.hpp"
 #include "statsim/world_checks.hpp"
@@ -216,6 +217,12 @@ class WorldCore {
     // Before the broad phase, which replaces last step's pairs (it does not read the flags).
     detail::forget_contacts(w_);
     detail::find_pairs(w_, result);
+    detail::record_impacts(w_, impacts_, [](std::uint32_t slot) { return BodyId(slot); });
+    result.impacts_found = impacts_.found;
+    if (impacts_.found > impacts_.count) {
+      result.impacts_dropped = impacts_.found - impacts_.count;
+      result.overflow |= overflow_impacts;
+    }
     result.contacts += detail::impact_pass(w_, ctx);
     // A support pass that changed no velocity and moved nothing would be repeated exactly by
     // the next one: stop there (a resting pile needs one pass, not `support_iterations`; the
@@ -286,6 +293,12 @@ class WorldCore {
   const Pair* pairs() const { return w_.pairs; }
   std::uint32_t pair_count() const { return w_.pair_count; }
 
+  /// The impacts of the last step above `WorldDef::impact_threshold` (see `Impact`), bodies
+  /// against planes first, up to `MaxImpacts`; `StepResult::impacts_dropped` counts the rest.
+  const Impact<D>* impacts() const { return impacts_.items; }
+  std::uint32_t impact_count() const { return impacts_.count; }
+  std::uint32_t impact_capacity() const { return impacts_.capacity; }
+
   /// Number of bodies in each motion state.
   std::uint32_t count(MotionState s) const
   {
@@ -311,6 +324,8 @@ class WorldCore {
     std::uint32_t* awake;
     std::uint32_t* flagged;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
+    Impact<D>* impacts;
+    std::uint32_t max_impacts;
   };
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
@@ -329,7 +344,8 @@ class WorldCore {
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
-           s.max_shapes}
+           s.max_shapes},
+        impacts_{s.impacts, s.max_impacts}
   {
     construction_status_ = configure(def);
     if (construction_status_ == Status::ok && detail::float_contraction()) construction_status_ = Status::float_contraction;
@@ -338,13 +354,15 @@ class WorldCore {
 
  private:
   detail::WorldData<D> w_;
+  detail::ImpactLog<D> impacts_;
   Status construction_status_ = Status::ok;
   std::uint16_t tag_ = detail::next_world_tag();
 };
 
 namespace detail {
 /// Storage of a World, a base class so that it is constructed before the core that points into it.
-template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes>
+template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes,
+          std::uint32_t MaxImpacts>
 struct WorldStorage {
   std::array<Body<D>, MaxBodies> body_store;
   alignas(16) std::array<unsigned char, detail::BroadPhaseLayout<D>::bytes(MaxBodies)> broad_phase_store;
@@ -353,18 +371,21 @@ struct WorldStorage {
   std::array<Shape<D>, MaxShapes> shape_store;
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
+  std::array<Impact<D>, MaxImpacts> impact_store;
 };
 }  // namespace detail
 
 /// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
-/// `overflow_pairs`) and `MaxShapes` shapes. All storage is inside the object: a large world
+/// `overflow_pairs`), `MaxShapes` shapes and `MaxImpacts` impact events per step (0: none recorded,
+/// none reported). All storage is inside the object: a large world
 /// belongs in static storage, not on the stack (10,000 bodies take about 2 MB with the default
 /// pair buffer).
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>, public WorldCore<D> {
-  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
+class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>,
+              public WorldCore<D> {
+  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
 
  public:
   static constexpr std::uint32_t max_bodies = MaxBodies;
@@ -384,7 +405,7 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                                                      StorageBase::shape_store.data(),
                                                      StorageBase::awake_store.data(),
                                                      StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
-                                                     MaxShapes},
+                                                     MaxShapes, StorageBase::impact_store.data(), MaxImpacts},
                      def)
   {
   }
@@ -395,11 +416,11 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
 /// position, a quaternion orientation and angular velocity vectors. Up is +z. See `World` for the
 /// capacities.
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
+using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
+using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
 using BodyDef2 = BodyDef<2>;
 using BodyDef3 = BodyDef<3>;
 using WorldDef2 = WorldDef<2>;

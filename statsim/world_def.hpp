@@ -213,6 +213,10 @@ struct WorldDef {
   /// Axis the sweep-and-prune broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
   /// along, not the up axis of a pile.
   int sweep_axis = 0;
+  /// Contacts approaching faster than this are reported as impact events, m/s, >= 0 (see
+  /// `WorldCore::impacts`; only in worlds with a `MaxImpacts` above 0). Typical: 1 (Box2D's
+  /// hit-event default); a body resting on the ground approaches at |g| dt each step.
+  Scalar impact_threshold = 1;
 };
 
 /// Full state of a body. Read it through `WorldCore::body()`; change it only through the world.
