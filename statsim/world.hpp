@@ -299,6 +299,11 @@ class WorldCore {
   std::uint32_t impact_count() const { return impacts_.count; }
   std::uint32_t impact_capacity() const { return impacts_.capacity; }
 
+  /// The id of the body in slot `slot` (< body_count()), or `no_body` for a free slot.
+  BodyId id_of(std::uint32_t slot) const { return slot < w_.body_count ? BodyId(slot) : no_body; }
+  /// The world's arrays, for the queries of statsim/queries.hpp: internal, their layout may change.
+  const detail::WorldData<D>& data() const { return w_; }
+
   /// Number of bodies in each motion state.
   std::uint32_t count(MotionState s) const
   {
