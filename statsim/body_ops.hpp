@@ -8,18 +8,16 @@
 #include "statsim/world_data.hpp"
 
 #include <cstdint>
+#include <limits>
 
 namespace statsim {
 namespace detail {
-
-/// `find_slot`'s answer for an id that names no body.
-constexpr std::uint32_t no_slot = 0xffffffffu;
 
 /// Slot index of the live body `id` names, or `no_slot` when it names none.
 template <int D>
 std::uint32_t find_slot(const WorldData<D>& w, BodyId id)
 {
-  return id < w.body_count ? id : no_slot;
+  return w.slots.find(id, w.body_count);
 }
 
 /// Adds a body whose state passed `check_state`, of a shape the world owns.
@@ -32,9 +30,17 @@ Added<BodyId> add_body(WorldData<D>& w, const BodyDef<D>& def)
   if (!finite(mass)) return {Status::non_finite, 0};
   if (!(mass > 0)) return {Status::invalid_mass, 0};
   if (mass < limits::min_mass || mass > limits::max_mass) return {Status::out_of_range, 0};
-  if (w.body_count == w.max_bodies) return {Status::capacity_exceeded, 0};
-
-  const BodyId id = w.body_count;
+  // A removed slot is reused before a new one, the lowest first.
+  BodySlots& slots = w.slots;
+  std::uint32_t id = w.body_count;
+  if (slots.free_count > 0) {
+    std::uint32_t k = 0;
+    while (slots.free[k] == 0) ++k;
+    id = k * 32 + lowest_bit(slots.free[k]);
+  } else if (w.body_count == w.max_bodies) {
+    return {Status::capacity_exceeded, 0};
+  }
+  const std::uint32_t generation = id < w.body_count ? slots.generation[id] : 0u;
   Body<D>& b = w.bodies[id];
   b.position = def.position;
   b.orientation = normalized(def.orientation);
@@ -48,7 +54,9 @@ Added<BodyId> add_body(WorldData<D>& w, const BodyDef<D>& def)
   b.inv_mass = Scalar(1) / mass;
   b.slow_time = 0;
   b.step_start = b.position;
-  b.rng_state = Pcg32(w.def.seed, body_stream(w.def.seed, id)).state();
+  // The slot's stream from another start in each generation (the first's is the seed's).
+  const std::uint64_t start = w.def.seed + generation * std::uint64_t(0x9e3779b97f4a7c15ull);
+  b.rng_state = Pcg32(start, body_stream(w.def.seed, id)).state();
   b.shape = def.shape.index;
   b.state = def.asleep ? MotionState::asleep : MotionState::moving;
   b.touching = false;
@@ -60,8 +68,61 @@ Added<BodyId> add_body(WorldData<D>& w, const BodyDef<D>& def)
     set_bit(w.awake, id);
     ++w.awake_count;
   }
-  ++w.body_count;
-  return {Status::ok, id};
+  if (id < w.body_count) {
+    clear_bit(slots.free, id);
+    --slots.free_count;
+    --slots.removed;
+    w.sweep_current = false;  // the slot's sweep entry is where the removed body was
+  } else {
+    slots.generation[id] = 0;
+    ++w.body_count;
+  }
+  return {Status::ok, make_body_id(id, generation)};
+}
+
+/// Removes a body: it leaves the awake set and the broad phase (at infinity, where no interval
+/// or cell reaches it), sleepers whose bounding spheres reach it wake (what rested on it), and
+/// its slot's generation advances so that its id is refused from now on.
+template <int D>
+Status remove_body(WorldData<D>& w, BodyId id)
+{
+  using Vec = typename Space<D>::Vec;
+  const std::uint32_t slot = find_slot(w, id);
+  if (slot == no_slot) return Status::invalid_body;
+  Body<D>& b = w.bodies[slot];
+  // Bodies resting on it touch it at their reach, give or take rounding: reaches grown by 1%.
+  for (std::uint32_t j = 0; j < w.body_count; ++j) {
+    Body<D>& o = w.bodies[j];
+    const Scalar reach = (b.bounding_radius + o.bounding_radius) * Scalar(1.01);
+    if (j != slot && o.state == MotionState::asleep && w.slots.live(j) &&
+        (o.position - b.position).squaredNorm() <= reach * reach)
+      wake(w, o);
+  }
+  if (b.state != MotionState::asleep) {
+    clear_bit(w.awake, slot);
+    --w.awake_count;
+  }
+  clear_bit(w.flagged, slot);
+  b.position = Vec::Constant(std::numeric_limits<Scalar>::infinity());
+  b.step_start = b.position;
+  b.linear_velocity = Vec::Zero();
+  b.angular_velocity = Space<D>::zero_spin();
+  b.state = MotionState::asleep;
+  b.touching = false;
+  b.on_ground = false;
+  b.rest_pose = no_rest_pose;
+  b.pile_rest = false;
+  b.rest_blend = 0;
+  b.slow_time = 0;
+  w.sweep_current = false;
+  const std::uint16_t generation = std::uint16_t(w.slots.generation[slot] + 1);
+  w.slots.generation[slot] = generation;
+  ++w.slots.removed;
+  if (generation != retired_generation) {
+    set_bit(w.slots.free, slot);
+    ++w.slots.free_count;
+  }
+  return Status::ok;
 }
 
 /// Moves a body and wakes it.

@@ -12,9 +12,6 @@
 
 namespace statsim {
 
-/// `Impact::b` of an impact with a plane.
-constexpr BodyId no_body = 0xffffffffu;
-
 /// One impact of the last step, as the impact pass met it: before any response of the step.
 template <int D>
 struct Impact {

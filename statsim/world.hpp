@@ -33,20 +33,9 @@
 #include "statsim/world_def.hpp"
 
 #include <array>
-#include <atomic>
 #include <cstdint>
 
 namespace statsim {
-
-namespace detail {
-/// A tag for a new world, 1 to 65535 (0 is the bare-index tag of `ShapeId`). Worlds made one after
-/// another get different tags until 65535 have been made; the tag never enters a simulation.
-inline std::uint16_t next_world_tag()
-{
-  static std::atomic<std::uint32_t> made{0};
-  return std::uint16_t(made.fetch_add(1, std::memory_order_relaxed) % 65535u + 1u);
-}
-}  // namespace detail
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
 template <int D>
@@ -192,6 +181,10 @@ class WorldCore {
   {
     return detail::apply_angular_impulse(w_, id, impulse);
   }
+  /// Removes a body. Its slot is reused by a later `add_body`, under a new id: this one is
+  /// refused with `invalid_body` from now on. Sleepers it reached (bounding spheres) wake.
+  /// `invalid_body` for an id that names no body.
+  Status remove_body(BodyId id) { return detail::remove_body(w_, id); }
   /// Wakes a body (an awake one starts its `sleep_time` again). `invalid_body`.
   Status wake(BodyId id) { return detail::wake_body(w_, id); }
   /// Puts a body to sleep where it is: its velocities become 0 and it is a static support until
@@ -217,7 +210,7 @@ class WorldCore {
     // Before the broad phase, which replaces last step's pairs (it does not read the flags).
     detail::forget_contacts(w_);
     detail::find_pairs(w_, result);
-    detail::record_impacts(w_, impacts_, [](std::uint32_t slot) { return BodyId(slot); });
+    detail::record_impacts(w_, impacts_, [this](std::uint32_t slot) { return id_of(slot); });
     result.impacts_found = impacts_.found;
     if (impacts_.found > impacts_.count) {
       result.impacts_dropped = impacts_.found - impacts_.count;
@@ -245,7 +238,10 @@ class WorldCore {
     return result;
   }
 
+  /// Slots in use, removed bodies' included: ids of live bodies have an index below it (`id_of`).
   std::uint32_t body_count() const { return w_.body_count; }
+  /// Bodies in the world: body_count() less the removed ones.
+  std::uint32_t live_body_count() const { return w_.body_count - w_.slots.removed; }
   std::uint32_t plane_count() const { return w_.plane_count; }
   std::uint32_t shape_count() const { return w_.shape_count; }
   std::uint32_t body_capacity() const { return w_.max_bodies; }
@@ -259,17 +255,22 @@ class WorldCore {
   /// rate is energy_clamp_count() / statistical_response_count().
   std::uint64_t statistical_response_count() const { return w_.statistical_responses; }
 
-  /// A body's state. `id` must be < body_count(): a caller's bug otherwise, reported by
-  /// STATSIM_ASSERT where assertions are on; where they are off the call reads the first slot
-  /// of the body storage instead of memory past it (meaningless, but memory-safe). For an id
-  /// that may be bad, use `find_body`.
+  /// A body's state. `id` must name a body of the world (`alive`): a caller's bug otherwise,
+  /// reported by STATSIM_ASSERT where assertions are on; where they are off the call reads the
+  /// first slot of the body storage instead of memory past it (meaningless, but memory-safe).
+  /// For an id that may be bad, use `find_body`.
   const Body<D>& body(BodyId id) const
   {
-    STATSIM_ASSERT(id < w_.body_count);
-    return w_.bodies[id < w_.body_count ? id : 0];
+    STATSIM_ASSERT(alive(id));
+    return w_.bodies[alive(id) ? body_index(id) : 0];
   }
-  /// A body's state, or nullptr if `id` is not < body_count().
-  [[nodiscard]] const Body<D>* find_body(BodyId id) const { return id < w_.body_count ? &w_.bodies[id] : nullptr; }
+  /// A body's state, or nullptr if `id` names no body (never added, or removed).
+  [[nodiscard]] const Body<D>* find_body(BodyId id) const
+  {
+    return alive(id) ? &w_.bodies[body_index(id)] : nullptr;
+  }
+  /// True when `id` names a body of the world: added and not removed.
+  bool alive(BodyId id) const { return w_.slots.find(id, w_.body_count) != detail::no_slot; }
   /// A plane. `id` must be < plane_count(), as for `body()`.
   const Plane<D>& plane(PlaneId id) const
   {
@@ -300,7 +301,7 @@ class WorldCore {
   std::uint32_t impact_capacity() const { return impacts_.capacity; }
 
   /// The id of the body in slot `slot` (< body_count()), or `no_body` for a free slot.
-  BodyId id_of(std::uint32_t slot) const { return slot < w_.body_count ? BodyId(slot) : no_body; }
+  BodyId id_of(std::uint32_t slot) const { return w_.slots.id(slot, w_.body_count); }
   /// The world's arrays, for the queries of statsim/queries.hpp: internal, their layout may change.
   const detail::WorldData<D>& data() const { return w_; }
 
@@ -308,7 +309,7 @@ class WorldCore {
   std::uint32_t count(MotionState s) const
   {
     std::uint32_t n = 0;
-    for (std::uint32_t i = 0; i < w_.body_count; ++i) n += w_.bodies[i].state == s;
+    for (std::uint32_t i = 0; i < w_.body_count; ++i) n += w_.bodies[i].state == s && w_.slots.live(i);
     return n;
   }
 
@@ -331,6 +332,8 @@ class WorldCore {
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
     Impact<D>* impacts;
     std::uint32_t max_impacts;
+    std::uint16_t* generations;
+    std::uint32_t* free_slots;
   };
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
@@ -352,6 +355,8 @@ class WorldCore {
            s.max_shapes},
         impacts_{s.impacts, s.max_impacts}
   {
+    w_.slots.generation = s.generations;
+    w_.slots.free = s.free_slots;
     construction_status_ = configure(def);
     if (construction_status_ == Status::ok && detail::float_contraction()) construction_status_ = Status::float_contraction;
   }
@@ -377,6 +382,8 @@ struct WorldStorage {
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
   std::array<Impact<D>, MaxImpacts> impact_store;
+  std::array<std::uint16_t, MaxBodies> generation_store;
+  std::array<std::uint32_t, detail::bit_words(MaxBodies)> free_store;
 };
 }  // namespace detail
 
@@ -398,7 +405,8 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   static constexpr std::uint32_t max_pairs = MaxPairs;
   static constexpr std::uint32_t max_shapes = MaxShapes;
   static_assert(MaxBodies > 0 && MaxPlanes > 0 && MaxPairs > 0 && MaxShapes > 0, "capacities must be positive");
-  static_assert(MaxShapes <= 65535 && MaxPlanes <= 65535, "shape and plane ids are 16-bit");
+  static_assert(MaxShapes <= 65535 && MaxPlanes < 65535, "shape and plane ids are 16-bit");
+  static_assert(MaxBodies <= 1u << body_index_bits, "body ids hold the slot in body_index_bits bits");
 
   /// A world with the given parameters; if they are invalid it uses the defaults and
   /// `construction_status()` says why.
@@ -410,7 +418,9 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                                                      StorageBase::shape_store.data(),
                                                      StorageBase::awake_store.data(),
                                                      StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
-                                                     MaxShapes, StorageBase::impact_store.data(), MaxImpacts},
+                                                     MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
+                                                     StorageBase::generation_store.data(),
+                                                     StorageBase::free_store.data()},
                      def)
   {
   }

@@ -5,6 +5,7 @@
 /// (`integrate`) and the state hash.
 
 #include "statsim/world_def.hpp"
+#include "statsim/world_ids.hpp"
 #include "statsim/random.hpp"
 
 #include <cstdint>
@@ -89,6 +90,7 @@ struct WorldData {
   std::uint64_t energy_clamps = 0;  ///< over the world's life
   std::uint64_t statistical_responses = 0;  ///< over the world's life
   WorldDef<D> def{};
+  BodySlots slots{};  ///< what names the body in each slot (`remove_body`)
 };
 
 /// What one step counts as its phases run; the passes reset the counter they test.
