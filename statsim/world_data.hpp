@@ -254,6 +254,12 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add(s.mean_rest_height);
     for (std::uint32_t k = 0; k < s.signature.rest.count; ++k) h.add(s.rest_bias[k]);
   }
+  // Slot generations decide the ids and random streams of reused slots; a world that never
+  // removed a body has none and hashes as before removal existed.
+  std::uint32_t removals = 0;
+  for (std::uint32_t i = 0; i < w.body_count; ++i) removals += w.slots.generation[i];
+  if (removals > 0)
+    for (std::uint32_t i = 0; i < w.body_count; ++i) h.add(w.slots.generation[i]);
   // The sweep-and-prune order breaks ties between equal interval starts, so it decides the order
   // of pairs, and with it of contacts.
   h.add(w.entry_count);

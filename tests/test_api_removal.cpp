@@ -163,3 +163,17 @@ TEST_CASE("spawning and removing every step is deterministic")
   CHECK(churn(600) == h);
   CHECK(churn(599) != h);
 }
+
+TEST_CASE("the state hash tells a reused slot's generation")
+{
+  auto once = std::make_unique<World3<2>>();
+  auto twice = std::make_unique<World3<2>>();
+  ShapeDef ball;
+  BodyDef3 bd;
+  for (World3<2>* w : {once.get(), twice.get()}) {
+    bd.shape = w->add_shape(ball).id;
+    REQUIRE(w->remove_body(w->add_body(bd).id) == Status::ok);
+  }
+  REQUIRE(twice->remove_body(twice->add_body(bd).id) == Status::ok);
+  CHECK(once->state_hash() != twice->state_hash());  // the next body gets another id and stream
+}
