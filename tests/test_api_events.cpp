@@ -7,6 +7,7 @@
 #include "statsim/random.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
+#include "tables/box.hpp"
 
 #include <cmath>
 #include <memory>
@@ -96,9 +97,12 @@ namespace {
 /// 60 spheres and cubes dropped into a box; returns the state hash after `steps` steps and
 /// counts the impacts and overflowing steps.
 template <class W>
-std::uint64_t drop_pile(W& w, int steps, std::uint32_t& impacts, int& overflows)
+std::uint64_t drop_pile(W& w, int steps, std::uint32_t& impacts, int& overflows, bool hulls = false)
 {
-  const ShapeId cube = w.add_shape(testing::cube_synthetic.view()).id;
+  WorldDef3 def;
+  if (hulls) def.body_contacts = BodyContacts::hulls;
+  REQUIRE(w.configure(def) == Status::ok);
+  const ShapeId cube = w.add_shape(hulls ? tables::box.view() : testing::cube_synthetic.view()).id;
   ShapeDef ball;
   ball.radius = 0.12f;
   const ShapeId sphere = w.add_shape(ball).id;
@@ -148,6 +152,14 @@ TEST_CASE("recording impacts leaves the simulation's bits alone; a full buffer i
   CHECK(few == all);
   CHECK(o_few > 0);
   CHECK(o_all == 0);
+
+  // With hull contacts (the box table's body-body data), whose witnesses recording finds too.
+  auto plain_hulls = std::make_unique<World3<60>>();
+  auto small_hulls = std::make_unique<World3<60, 8, 360, 8, 2>>();
+  const std::uint64_t hh = drop_pile(*plain_hulls, 240, none, o_none, true);
+  CHECK(drop_pile(*small_hulls, 240, few, o_few, true) == hh);
+  CHECK(hh != h);
+  CHECK(few > 60);
 }
 
 TEST_CASE("the impact threshold is a world parameter")
