@@ -59,6 +59,10 @@ enum Overflow : std::uint32_t {
   /// More candidate pairs than the pair buffer holds: raise the world's `MaxPairs`. The pairs
   /// beyond it were not resolved this step (their count is in `StepResult::pairs_dropped`).
   overflow_pairs = 1u << 0,
+  /// More impacts above `WorldDef::impact_threshold` than the impact buffer holds: raise the
+  /// world's `MaxImpacts`. The first ones were kept (`StepResult::impacts_dropped` counts the
+  /// rest); the simulation is the same either way.
+  overflow_impacts = 1u << 1,
 };
 
 /// What a call to `step()` did.
@@ -70,6 +74,8 @@ struct [[nodiscard]] StepResult {
   std::uint32_t contacts = 0;        ///< body-body and body-plane contacts resolved
   std::uint32_t energy_clamps = 0;   ///< sampled responses the energy guard scaled down
   std::uint32_t statistical_responses = 0;  ///< sampled responses applied (body-plane and body-body)
+  std::uint32_t impacts_found = 0;    ///< impacts above the threshold (incl. dropped); 0 without a buffer
+  std::uint32_t impacts_dropped = 0;  ///< impacts that did not fit the impact buffer
   /// Work of the step, for tests and profiling: bodies integrated (the awake ones), bodies the
   /// broad phase read, and candidate pairs the grid examined (bounding-sphere tests;
   /// sweep-and-prune does not count its own). A world whose bodies are all asleep does none of it.

@@ -23,7 +23,9 @@
 /// Sleeping bodies are not integrated and act as static supports until hit harder than
 /// `wake_speed`.
 
+#include "statsim/body_ops.hpp"
 #include "statsim/contact_solver.hpp"
+#include "statsim/events.hpp"
 #include "statsim/find_pairs.hpp"
 #include "statsim/rest_and_sleep.hpp"
 #include "statsim/world_checks.hpp"
@@ -31,20 +33,9 @@
 #include "statsim/world_def.hpp"
 
 #include <array>
-#include <atomic>
 #include <cstdint>
 
 namespace statsim {
-
-namespace detail {
-/// A tag for a new world, 1 to 65535 (0 is the bare-index tag of `ShapeId`). Worlds made one after
-/// another get different tags until 65535 have been made; the tag never enters a simulation.
-inline std::uint16_t next_world_tag()
-{
-  static std::atomic<std::uint32_t> made{0};
-  return std::uint16_t(made.fetch_add(1, std::memory_order_relaxed) % 65535u + 1u);
-}
-}  // namespace detail
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
 template <int D>
@@ -160,68 +151,45 @@ class WorldCore {
     const Status s = detail::check_state<D>(def.position, def.orientation, def.linear_velocity, def.angular_velocity);
     if (s != Status::ok) return {s, 0};
     if (!owns(def.shape)) return {Status::invalid_shape, 0};
-    const Shape<D>& shape = w_.shapes[def.shape.index];
-    const Scalar mass = def.mass == 0 ? shape.mass : def.mass;
-    if (!detail::finite(mass)) return {Status::non_finite, 0};
-    if (!(mass > 0)) return {Status::invalid_mass, 0};
-    if (mass < limits::min_mass || mass > limits::max_mass) return {Status::out_of_range, 0};
-    if (w_.body_count == w_.max_bodies) return {Status::capacity_exceeded, 0};
-
-    const BodyId id = w_.body_count;
-    Body<D>& b = w_.bodies[id];
-    b.position = def.position;
-    b.orientation = detail::normalized(def.orientation);
-    b.linear_velocity = def.asleep ? Vec::Zero() : def.linear_velocity;
-    b.angular_velocity = def.asleep ? Space<D>::zero_spin() : def.angular_velocity;
-    b.radius = shape.statistical
-                   ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
-                   : shape.radius;
-    b.bounding_radius = shape.bounding_radius;
-    w_.widest = 2 * b.bounding_radius > w_.widest ? 2 * b.bounding_radius : w_.widest;
-    b.inv_mass = Scalar(1) / mass;
-    b.slow_time = 0;
-    b.step_start = b.position;
-    b.rng_state = Pcg32(w_.def.seed, body_stream(w_.def.seed, id)).state();
-    b.shape = def.shape.index;
-    b.state = def.asleep ? MotionState::asleep : MotionState::moving;
-    b.touching = false;
-    b.on_ground = false;
-    b.rest_pose = no_rest_pose;
-    b.pile_rest = false;
-    b.rest_blend = 0;
-    if (!def.asleep) {
-      detail::set_bit(w_.awake, id);
-      ++w_.awake_count;
-    }
-    ++w_.body_count;
-    return {Status::ok, id};
+    return detail::add_body(w_, def);
   }
 
-  /// Sets a body's velocities and wakes it.
+  /// Sets a body's velocities (m/s, rad/s) and wakes it. `invalid_body`, `non_finite`,
+  /// `out_of_range` (beyond `limits::speed`, `limits::spin`).
   Status set_velocity(BodyId id, const Vec& linear, const Spin& angular)
   {
-    if (id >= w_.body_count) return Status::invalid_body;
-    if (!detail::finite(linear) || !detail::finite(angular)) return Status::non_finite;
-    if (!detail::within(linear, limits::speed) || !detail::within(angular, limits::spin)) return Status::out_of_range;
-    Body<D>& b = w_.bodies[id];
-    b.linear_velocity = linear;
-    b.angular_velocity = angular;
-    detail::wake(w_, b);
-    return Status::ok;
+    const std::uint32_t slot = detail::find_slot(w_, id);
+    return slot == detail::no_slot ? Status::invalid_body : detail::set_velocities(w_, slot, linear, angular);
   }
-
-  /// Moves a body and wakes it.
+  /// Moves a body (m; a unit orientation) and wakes it. `invalid_body`, or as `add_body`.
   Status set_transform(BodyId id, const Vec& position, const Rot& orientation)
   {
-    if (id >= w_.body_count) return Status::invalid_body;
-    const Status s = detail::check_state<D>(position, orientation, Vec::Zero(), Space<D>::zero_spin());
-    if (s != Status::ok) return s;
-    Body<D>& b = w_.bodies[id];
-    b.position = position;
-    b.orientation = detail::normalized(orientation);
-    detail::wake(w_, b);
-    return Status::ok;
+    return detail::set_transform(w_, id, position, orientation);
   }
+  /// Adds `impulse` (N s, world frame) at `point` (m, world): the body's velocity changes by
+  /// impulse / m and its angular velocity by I^-1 ((point - centre) x impulse), I its inertia
+  /// (a table's `unit_inertia` times m, or 2/5 m r^2 for a sphere, 1/2 m r^2 for a 2D disc).
+  /// Wakes the body. `invalid_body`, `non_finite`, `out_of_range` (a point beyond
+  /// `limits::coordinate`, or velocities beyond `limits::speed` / `limits::spin` after it).
+  Status apply_impulse(BodyId id, const Vec& impulse, const Vec& point)
+  {
+    return detail::apply_impulse(w_, id, impulse, point);
+  }
+  /// Adds an angular impulse (N m s, world frame; 2D: counter-clockwise): the angular velocity
+  /// changes by I^-1 impulse. Wakes the body. Statuses as `apply_impulse`.
+  Status apply_angular_impulse(BodyId id, const Spin& impulse)
+  {
+    return detail::apply_angular_impulse(w_, id, impulse);
+  }
+  /// Removes a body. Its slot is reused by a later `add_body`, under a new id: this one is
+  /// refused with `invalid_body` from now on. Sleepers it reached (bounding spheres) wake.
+  /// `invalid_body` for an id that names no body.
+  Status remove_body(BodyId id) { return detail::remove_body(w_, id); }
+  /// Wakes a body (an awake one starts its `sleep_time` again). `invalid_body`.
+  Status wake(BodyId id) { return detail::wake_body(w_, id); }
+  /// Puts a body to sleep where it is: its velocities become 0 and it is a static support until
+  /// hit faster than `wake_speed`, woken or moved. `ok` also for a sleeping body; `invalid_body`.
+  Status sleep(BodyId id) { return detail::sleep_body(w_, id); }
 
   /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` (not
   /// `out_of_range`) if dt is not finite and positive or exceeds `limits::time_step` (1 s); then
@@ -242,6 +210,12 @@ class WorldCore {
     // Before the broad phase, which replaces last step's pairs (it does not read the flags).
     detail::forget_contacts(w_);
     detail::find_pairs(w_, result);
+    detail::record_impacts(w_, impacts_, [this](std::uint32_t slot) { return id_of(slot); });
+    result.impacts_found = impacts_.found;
+    if (impacts_.found > impacts_.count) {
+      result.impacts_dropped = impacts_.found - impacts_.count;
+      result.overflow |= overflow_impacts;
+    }
     result.contacts += detail::impact_pass(w_, ctx);
     // A support pass that changed no velocity and moved nothing would be repeated exactly by
     // the next one: stop there (a resting pile needs one pass, not `support_iterations`; the
@@ -264,7 +238,10 @@ class WorldCore {
     return result;
   }
 
+  /// Slots in use, removed bodies' included: ids of live bodies have an index below it (`id_of`).
   std::uint32_t body_count() const { return w_.body_count; }
+  /// Bodies in the world: body_count() less the removed ones.
+  std::uint32_t live_body_count() const { return w_.body_count - w_.slots.removed; }
   std::uint32_t plane_count() const { return w_.plane_count; }
   std::uint32_t shape_count() const { return w_.shape_count; }
   std::uint32_t body_capacity() const { return w_.max_bodies; }
@@ -278,17 +255,22 @@ class WorldCore {
   /// rate is energy_clamp_count() / statistical_response_count().
   std::uint64_t statistical_response_count() const { return w_.statistical_responses; }
 
-  /// A body's state. `id` must be < body_count(): a caller's bug otherwise, reported by
-  /// STATSIM_ASSERT where assertions are on; where they are off the call reads the first slot
-  /// of the body storage instead of memory past it (meaningless, but memory-safe). For an id
-  /// that may be bad, use `find_body`.
+  /// A body's state. `id` must name a body of the world (`alive`): a caller's bug otherwise,
+  /// reported by STATSIM_ASSERT where assertions are on; where they are off the call reads the
+  /// first slot of the body storage instead of memory past it (meaningless, but memory-safe).
+  /// For an id that may be bad, use `find_body`.
   const Body<D>& body(BodyId id) const
   {
-    STATSIM_ASSERT(id < w_.body_count);
-    return w_.bodies[id < w_.body_count ? id : 0];
+    STATSIM_ASSERT(alive(id));
+    return w_.bodies[alive(id) ? body_index(id) : 0];
   }
-  /// A body's state, or nullptr if `id` is not < body_count().
-  [[nodiscard]] const Body<D>* find_body(BodyId id) const { return id < w_.body_count ? &w_.bodies[id] : nullptr; }
+  /// A body's state, or nullptr if `id` names no body (never added, or removed).
+  [[nodiscard]] const Body<D>* find_body(BodyId id) const
+  {
+    return alive(id) ? &w_.bodies[body_index(id)] : nullptr;
+  }
+  /// True when `id` names a body of the world: added and not removed.
+  bool alive(BodyId id) const { return w_.slots.find(id, w_.body_count) != detail::no_slot; }
   /// A plane. `id` must be < plane_count(), as for `body()`.
   const Plane<D>& plane(PlaneId id) const
   {
@@ -312,11 +294,22 @@ class WorldCore {
   const Pair* pairs() const { return w_.pairs; }
   std::uint32_t pair_count() const { return w_.pair_count; }
 
+  /// The impacts of the last step above `WorldDef::impact_threshold` (see `Impact`), bodies
+  /// against planes first, up to `MaxImpacts`; `StepResult::impacts_dropped` counts the rest.
+  const Impact<D>* impacts() const { return impacts_.items; }
+  std::uint32_t impact_count() const { return impacts_.count; }
+  std::uint32_t impact_capacity() const { return impacts_.capacity; }
+
+  /// The id of the body in slot `slot` (< body_count()), or `no_body` for a free slot.
+  BodyId id_of(std::uint32_t slot) const { return w_.slots.id(slot, w_.body_count); }
+  /// The world's arrays, for the queries of statsim/queries.hpp: internal, their layout may change.
+  const detail::WorldData<D>& data() const { return w_; }
+
   /// Number of bodies in each motion state.
   std::uint32_t count(MotionState s) const
   {
     std::uint32_t n = 0;
-    for (std::uint32_t i = 0; i < w_.body_count; ++i) n += w_.bodies[i].state == s;
+    for (std::uint32_t i = 0; i < w_.body_count; ++i) n += w_.bodies[i].state == s && w_.slots.live(i);
     return n;
   }
 
@@ -337,6 +330,10 @@ class WorldCore {
     std::uint32_t* awake;
     std::uint32_t* flagged;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
+    Impact<D>* impacts;
+    std::uint32_t max_impacts;
+    std::uint16_t* generations;
+    std::uint32_t* free_slots;
   };
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
@@ -355,8 +352,11 @@ class WorldCore {
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
-           s.max_shapes}
+           s.max_shapes},
+        impacts_{s.impacts, s.max_impacts}
   {
+    w_.slots.generation = s.generations;
+    w_.slots.free = s.free_slots;
     construction_status_ = configure(def);
     if (construction_status_ == Status::ok && detail::float_contraction()) construction_status_ = Status::float_contraction;
   }
@@ -364,13 +364,15 @@ class WorldCore {
 
  private:
   detail::WorldData<D> w_;
+  detail::ImpactLog<D> impacts_;
   Status construction_status_ = Status::ok;
   std::uint16_t tag_ = detail::next_world_tag();
 };
 
 namespace detail {
 /// Storage of a World, a base class so that it is constructed before the core that points into it.
-template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes>
+template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes,
+          std::uint32_t MaxImpacts>
 struct WorldStorage {
   std::array<Body<D>, MaxBodies> body_store;
   alignas(16) std::array<unsigned char, detail::BroadPhaseLayout<D>::bytes(MaxBodies)> broad_phase_store;
@@ -379,18 +381,23 @@ struct WorldStorage {
   std::array<Shape<D>, MaxShapes> shape_store;
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
   std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
+  std::array<Impact<D>, MaxImpacts> impact_store;
+  std::array<std::uint16_t, MaxBodies> generation_store;
+  std::array<std::uint32_t, detail::bit_words(MaxBodies)> free_store;
 };
 }  // namespace detail
 
 /// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
-/// `overflow_pairs`) and `MaxShapes` shapes. All storage is inside the object: a large world
+/// `overflow_pairs`), `MaxShapes` shapes and `MaxImpacts` impact events per step (0: none recorded,
+/// none reported). All storage is inside the object: a large world
 /// belongs in static storage, not on the stack (10,000 bodies take about 2 MB with the default
 /// pair buffer).
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>, public WorldCore<D> {
-  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
+class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>,
+              public WorldCore<D> {
+  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
 
  public:
   static constexpr std::uint32_t max_bodies = MaxBodies;
@@ -398,7 +405,8 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   static constexpr std::uint32_t max_pairs = MaxPairs;
   static constexpr std::uint32_t max_shapes = MaxShapes;
   static_assert(MaxBodies > 0 && MaxPlanes > 0 && MaxPairs > 0 && MaxShapes > 0, "capacities must be positive");
-  static_assert(MaxShapes <= 65535 && MaxPlanes <= 65535, "shape and plane ids are 16-bit");
+  static_assert(MaxShapes <= 65535 && MaxPlanes < 65535, "shape and plane ids are 16-bit");
+  static_assert(MaxBodies <= 1u << body_index_bits, "body ids hold the slot in body_index_bits bits");
 
   /// A world with the given parameters; if they are invalid it uses the defaults and
   /// `construction_status()` says why.
@@ -410,7 +418,9 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                                                      StorageBase::shape_store.data(),
                                                      StorageBase::awake_store.data(),
                                                      StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
-                                                     MaxShapes},
+                                                     MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
+                                                     StorageBase::generation_store.data(),
+                                                     StorageBase::free_store.data()},
                      def)
   {
   }
@@ -421,11 +431,11 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
 /// position, a quaternion orientation and angular velocity vectors. Up is +z. See `World` for the
 /// capacities.
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
+using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
+using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
 using BodyDef2 = BodyDef<2>;
 using BodyDef3 = BodyDef<3>;
 using WorldDef2 = WorldDef<2>;

@@ -20,7 +20,7 @@ Status check_world_def(const WorldDef<D>& d)
       !finite(d.sleep_time) || !finite(d.wake_speed) || !finite(d.linear_damping) || !finite(d.angular_damping) ||
       !finite(d.allowed_overlap) || !finite(d.overlap_correction) || !finite(d.rest_blend_time) ||
       !finite(d.rest_turn_time) || !finite(d.ground_cosine) || !finite(d.rest_snap_cosine) ||
-      !finite(d.spin_ratio_speed_floor))
+      !finite(d.spin_ratio_speed_floor) || !finite(d.impact_threshold))
     return Status::non_finite;
   if (d.restitution_threshold < 0 || d.settle_speed < 0 || d.sleep_speed < 0 || d.sleep_time < 0 ||
       d.wake_speed < 0 || d.linear_damping < 0 || d.angular_damping < 0 || d.support_iterations < 1 ||
@@ -30,7 +30,7 @@ Status check_world_def(const WorldDef<D>& d)
       !(d.overlap_correction > 0) || d.overlap_correction > 1 || !(d.rest_blend_time > 0) ||
       !(d.rest_turn_time > 0) || d.ground_cosine < 0 || d.ground_cosine > 1 || d.rest_snap_cosine < 0 ||
       d.rest_snap_cosine > 1 || d.spin_ratio_speed_floor < 0 || d.sweep_axis < 0 || d.sweep_axis >= D ||
-      !within(d.gravity, limits::gravity) || d.rest_turn_time < Scalar(1e-4))
+      !within(d.gravity, limits::gravity) || d.rest_turn_time < Scalar(1e-4) || d.impact_threshold < 0)
     return Status::invalid_parameter;
   return Status::ok;
 }

@@ -5,6 +5,7 @@
 /// (`integrate`) and the state hash.
 
 #include "statsim/world_def.hpp"
+#include "statsim/world_ids.hpp"
 #include "statsim/random.hpp"
 
 #include <cstdint>
@@ -89,6 +90,7 @@ struct WorldData {
   std::uint64_t energy_clamps = 0;  ///< over the world's life
   std::uint64_t statistical_responses = 0;  ///< over the world's life
   WorldDef<D> def{};
+  BodySlots slots{};  ///< what names the body in each slot (`remove_body`)
 };
 
 /// What one step counts as its phases run; the passes reset the counter they test.
@@ -169,6 +171,7 @@ void hash_def(Fnv1a& h, const WorldDef<D>& d)
             d.grid_above_bodies, std::int32_t(d.sweep_axis), std::uint8_t(d.table_restitution_threshold));
   // Added only when not the default, so that worlds from before the option keep their hashes.
   if (d.body_contacts != BodyContacts::collision_spheres) h.add(std::uint8_t(d.body_contacts));
+  if (d.impact_threshold != WorldDef<D>{}.impact_threshold) h.add(d.impact_threshold);
 }
 
 /// Adds a table's numbers as the runtime reads them (16-bit ones as their values).
@@ -251,6 +254,12 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add(s.mean_rest_height);
     for (std::uint32_t k = 0; k < s.signature.rest.count; ++k) h.add(s.rest_bias[k]);
   }
+  // Slot generations decide the ids and random streams of reused slots; a world that never
+  // removed a body has none and hashes as before removal existed.
+  std::uint32_t removals = 0;
+  for (std::uint32_t i = 0; i < w.body_count; ++i) removals += w.slots.generation[i];
+  if (removals > 0)
+    for (std::uint32_t i = 0; i < w.body_count; ++i) h.add(w.slots.generation[i]);
   // The sweep-and-prune order breaks ties between equal interval starts, so it decides the order
   // of pairs, and with it of contacts.
   h.add(w.entry_count);

@@ -38,8 +38,24 @@ bool within(const V& v, Scalar bound)
 inline bool within(Scalar x, Scalar bound) { return std::fabs(x) <= bound; }
 }  // namespace detail
 
-/// Index of a body in its world, in order of creation.
+/// Names a body of one world: its slot (the low `body_index_bits` bits) and the slot's
+/// generation (the high 12 bits), which `remove_body` advances. A world refuses an id of a body
+/// removed since with `Status::invalid_body`, also once its slot holds another body. In a world
+/// that removes nothing, ids are the indices 0, 1, 2, ... in order of creation.
 using BodyId = std::uint32_t;
+constexpr std::uint32_t body_index_bits = 20;
+/// The id of no body (`Impact::b` of a plane impact, `QueryHit::body` of a plane); never issued.
+constexpr BodyId no_body = 0xffffffffu;
+constexpr std::uint32_t body_index(BodyId id) { return id & ((1u << body_index_bits) - 1u); }
+constexpr std::uint32_t body_generation(BodyId id) { return id >> body_index_bits; }
+constexpr BodyId make_body_id(std::uint32_t index, std::uint32_t generation)
+{
+  return generation << body_index_bits | index;
+}
+namespace detail {
+/// A slot index that names no slot.
+constexpr std::uint32_t no_slot = 0xffffffffu;
+}  // namespace detail
 /// Names a shape of one world: its index in order of creation and the tag of the world that
 /// made it. `add_shape` returns tagged ids, and a world rejects a tagged id of another world with
 /// `Status::invalid_shape`, so an id cannot silently mean another world's shape. `ShapeId{}` and
@@ -213,6 +229,10 @@ struct WorldDef {
   /// Axis the sweep-and-prune broad phase sweeps along: 0 = x, 1 = y (2 = z in 3D). Pick one the scene spreads
   /// along, not the up axis of a pile.
   int sweep_axis = 0;
+  /// Contacts approaching faster than this are reported as impact events, m/s, >= 0 (see
+  /// `WorldCore::impacts`; only in worlds with a `MaxImpacts` above 0). Typical: 1 (Box2D's
+  /// hit-event default); a body resting on the ground approaches at |g| dt each step.
+  Scalar impact_threshold = 1;
 };
 
 /// Full state of a body. Read it through `WorldCore::body()`; change it only through the world.

@@ -8,6 +8,7 @@
 
 #include "scenes/synthetic_signatures.hpp"
 
+#include "statsim/queries.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 
@@ -78,6 +79,8 @@ constexpr std::uint32_t N3 = 128, N2 = 128, N_big = 10000;
 alignas(World3<N3>) unsigned char storage3[sizeof(World3<N3>)];
 alignas(World2<N2>) unsigned char storage2[sizeof(World2<N2>)];
 alignas(World3<N_big>) unsigned char storage_big[sizeof(World3<N_big>)];
+using EventWorld = World3<64, 8, 384, 8, 32>;
+alignas(EventWorld) unsigned char storage_events[sizeof(EventWorld)];
 
 template <int D, class W>
 void populate_and_step(W& w, int steps)
@@ -157,5 +160,46 @@ TEST_CASE("no heap allocation in construction and stepping of a 10000-body stati
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(g_allocations.load() == 0);
   CHECK(w->count(MotionState::moving) < N_big);  // bodies did land: contacts were exercised
+  std::destroy_at(w);
+}
+
+TEST_CASE("no heap allocation in impulses, sleep and wake, removal, impact events and queries")
+{
+  g_allocations = 0;
+  Eigen::internal::set_is_malloc_allowed(false);
+  g_counting = true;
+  auto* w = new (storage_events) EventWorld();
+  REQUIRE(w->add_shape(statsim::testing::cube_synthetic.view()).ok());
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+  Pcg32 g(5, 6);
+  BodyId ids[64];
+  for (BodyId& id : ids) {
+    BodyDef3 b;
+    b.position = Vector3(g.uniform(-1, 1), g.uniform(-1, 1), g.uniform(0.2f, 3));
+    id = w->add_body(b).id;
+  }
+  std::uint32_t impacts = 0, hits = 0;
+  for (int i = 0; i < 600; ++i) {
+    BodyId& id = ids[i % 64];
+    REQUIRE(w->remove_body(id) == Status::ok);
+    BodyDef3 b;
+    b.position = Vector3(g.uniform(-1, 1), g.uniform(-1, 1), 2);
+    id = w->add_body(b).id;
+    REQUIRE(w->apply_impulse(ids[(i + 7) % 64], Vector3(0, 0, 1), Vector3::Zero()) == Status::ok);
+    REQUIRE(w->sleep(ids[(i + 13) % 64]) == Status::ok);
+    REQUIRE(w->wake(ids[(i + 29) % 64]) == Status::ok);
+    REQUIRE(w->step(1.0f / 60).status == Status::ok);
+    impacts += w->impact_count();
+    QueryHit<3> hit;
+    REQUIRE(ray_cast(*w, Vector3(0, 0, 5), Vector3(0, 0, -1), 10, hit) == Status::ok);
+    hits += hit.hit();
+    REQUIRE(overlap_sphere(*w, Vector3::Zero(), 0.5f, [&hits](const QueryHit<3>&) { return ++hits, true; }) ==
+            Status::ok);
+  }
+  g_counting = false;
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(g_allocations.load() == 0);
+  CHECK(impacts > 0);
+  CHECK(hits > 0);
   std::destroy_at(w);
 }

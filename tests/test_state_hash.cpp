@@ -75,6 +75,7 @@ TEST_CASE("state_hash differs for worlds that differ in any parameter, material 
         {"broad_phase", [](WorldDef3& d) { d.broad_phase = BroadPhase::grid; }},
         {"grid_above_bodies", [](WorldDef3& d) { d.grid_above_bodies = 4; }},
         {"sweep_axis", [](WorldDef3& d) { d.sweep_axis = 1; }},
+        {"impact_threshold", [](WorldDef3& d) { d.impact_threshold = 2; }},
     };
     for (const DefChange& c : def_changes) {
       CAPTURE(c.first);

@@ -1,0 +1,87 @@
+#pragma once
+/// @file
+/// Impact events: the contacts of a step that approach faster than
+/// `WorldDef::impact_threshold`, recorded into a fixed buffer the world owns (`World`'s
+/// `MaxImpacts`). Recording only reads the world, before the impact pass responds to anything:
+/// a world steps to the same bits whether it records or not.
+
+#include "statsim/hull_contact.hpp"
+#include "statsim/world_data.hpp"
+
+#include <cstdint>
+
+namespace statsim {
+
+/// One impact of the last step, as the impact pass met it: before any response of the step.
+template <int D>
+struct Impact {
+  using Vec = typename Space<D>::Vec;
+  BodyId a;       ///< the (first) body
+  BodyId b;       ///< the other body, or `no_body` for an impact with plane `plane`
+  PlaneId plane;  ///< meaningful when b == no_body
+  /// Contact point, m: the foot of a's centre on the plane; between two bodies, on the line of
+  /// their centres, dividing it in the ratio of their collision radii.
+  Vec point;
+  /// Unit normal: from a towards b; with a plane, the plane's normal (out of it, towards a).
+  Vec normal;
+  /// Speed at which the bodies approach along the normal, m/s (> `WorldDef::impact_threshold`).
+  Scalar approach_speed;
+};
+
+namespace detail {
+
+/// The impact buffer of a world and what the last step put in it.
+template <int D>
+struct ImpactLog {
+  Impact<D>* items = nullptr;
+  std::uint32_t capacity = 0;
+  std::uint32_t count = 0;  ///< recorded, <= capacity
+  std::uint32_t found = 0;  ///< above the threshold, recorded or not
+
+  void add(const Impact<D>& i)
+  {
+    if (count < capacity) items[count++] = i;
+    ++found;
+  }
+};
+
+/// Fills `log` with the impacts that the impact pass is about to resolve: awake bodies against
+/// planes, in the pass's order, then the candidate pairs that touch, as `body_contact` finds them
+/// (on copies: the pass finds them again itself). `id_of(slot)` is the id of the body in a slot.
+template <int D, class IdOf>
+void record_impacts(const WorldData<D>& w, ImpactLog<D>& log, IdOf&& id_of)
+{
+  using Vec = typename Space<D>::Vec;
+  log.count = 0;
+  log.found = 0;
+  if (log.capacity == 0) return;
+  const Scalar threshold = w.def.impact_threshold;
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
+    const Body<D>& b = w.bodies[i];
+    for (std::uint32_t p = 0; p < w.plane_count; ++p) {
+      const Plane<D>& plane = w.planes[p];
+      Contact<D> c;
+      if (!sphere_plane_contact<D>(b.position, plane_radius(w, b, plane), plane, c)) continue;
+      const Scalar approach = -b.linear_velocity.dot(c.normal);
+      if (!(approach > threshold)) continue;
+      const Vec foot = b.position - c.normal * (c.normal.dot(b.position) - plane.offset);
+      log.add(Impact<D>{id_of(i), no_body, PlaneId(p), foot, c.normal, approach});
+    }
+  });
+  for (std::uint32_t k = 0; k < w.pair_count; ++k) {
+    Pair pair = w.pairs[k];
+    Body<D> a = w.bodies[pair.a];
+    Body<D> b = w.bodies[pair.b];
+    Contact<D> c;
+    Scalar reach, slop;
+    if (!body_contact(w, a, b, pair, true, Scalar(0), c, reach, slop)) continue;
+    const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(c.normal);
+    if (!(approach > threshold)) continue;
+    const Scalar gap = (b.position - a.position).norm();
+    const Vec point = a.position + c.normal * (gap * (a.radius / (a.radius + b.radius)));
+    log.add(Impact<D>{id_of(pair.a), id_of(pair.b), 0, point, c.normal, approach});
+  }
+}
+
+}  // namespace detail
+}  // namespace statsim
