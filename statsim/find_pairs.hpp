@@ -19,7 +19,7 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, std::uint32_t&
 {
   const Body<D>& ba = w.bodies[a];
   const Body<D>& bb = w.bodies[b];
-  const Scalar reach = ba.bounding_radius + bb.bounding_radius;
+  const Scalar reach = w.shapes[ba.shape].bounding_radius + w.shapes[bb.shape].bounding_radius;
   if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
   if (found < w.max_pairs) w.pairs[found] = a < b ? Pair{a, b} : Pair{b, a};
   ++found;
@@ -53,6 +53,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
   const Scalar half_cell = Scalar(0.5) * widest * grid.inv_cell;  // the widest bounding radius, in cells
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     const Body<D>& bi = w.bodies[i];
+    const Scalar bound_i = w.shapes[bi.shape].bounding_radius;
     std::int32_t c[3];
     cell(i, c);
     // Where the body is in its cell, in cells: a neighbouring cell holds a body it can touch only
@@ -66,9 +67,9 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
       high[k] = 1 - low[k];
       margin += std::fabs(u) * Scalar(1e-6);
     }
-    const Scalar r = bi.bounding_radius * grid.inv_cell + half_cell + margin;
+    const Scalar r = bound_i * grid.inv_cell + half_cell + margin;
     const Scalar r2 = r * r;
-    const Scalar reach_max = bi.bounding_radius + Scalar(0.5) * widest;
+    const Scalar reach_max = bound_i + Scalar(0.5) * widest;
     const Scalar reach_max2 = reach_max * reach_max;
     // A bucket is searched once, where it first comes in the order of the cells, if any of
     // its cells is within reach: the pairs come in the same order as from searching them all.
@@ -111,7 +112,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
         const Scalar d2 = (it->position - bi.position).squaredNorm();
         if (d2 > reach_max2) continue;
         const std::uint32_t j = it->key & ~asleep_key;
-        const Scalar reach = bi.bounding_radius + w.bodies[j].bounding_radius;
+        const Scalar reach = bound_i + w.shapes[w.bodies[j].shape].bounding_radius;
         if (d2 > reach * reach) continue;
         if (found < w.max_pairs) w.pairs[found] = Pair{i < j ? i : j, i < j ? j : i};
         ++found;
@@ -138,10 +139,11 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     SweepEntry& e = w.entries[i];
     const Body<D>& b = w.bodies[e.body];
-    e.lo = b.position[axis] - b.bounding_radius;
-    e.hi = b.position[axis] + b.bounding_radius;
+    const Scalar bound = w.shapes[b.shape].bounding_radius;
+    e.lo = b.position[axis] - bound;
+    e.hi = b.position[axis] + bound;
     e.active = b.state != MotionState::asleep ? 1u : 0u;
-    widest = 2 * b.bounding_radius > widest ? 2 * b.bounding_radius : widest;
+    widest = 2 * bound > widest ? 2 * bound : widest;
   }
   result.broad_phase_bodies += w.body_count;
   insertion_sort(w.entries, w.body_count);

@@ -176,8 +176,7 @@ class WorldCore {
     b.radius = shape.statistical
                    ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
                    : shape.radius;
-    b.bounding_radius = shape.bounding_radius;
-    w_.widest = 2 * b.bounding_radius > w_.widest ? 2 * b.bounding_radius : w_.widest;
+    w_.widest = 2 * shape.bounding_radius > w_.widest ? 2 * shape.bounding_radius : w_.widest;
     b.inv_mass = Scalar(1) / mass;
     b.slow_time = 0;
     b.step_start = b.position;

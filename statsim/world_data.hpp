@@ -234,7 +234,8 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add_rot(b.orientation);
     h.add_vec(b.linear_velocity);
     h.add_spin(b.angular_velocity);
-    h.add_all(b.radius, b.bounding_radius, b.inv_mass, b.slow_time, b.rng_state, b.rest_blend, b.shape,
+    h.add_all(b.radius, w.shapes[b.shape].bounding_radius, b.inv_mass, b.slow_time, std::uint64_t(b.rng_state),
+              b.rest_blend, b.shape,
               std::uint8_t(b.state), std::uint8_t(b.touching), std::uint8_t(b.on_ground), b.rest_pose,
               std::uint8_t(b.pile_rest));
   }

@@ -160,7 +160,7 @@ TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skip
         const Body3& a = world->body(i);
         const Body3& b = world->body(j);
         if (a.state == MotionState::asleep && b.state == MotionState::asleep) continue;
-        const float reach = a.bounding_radius + b.bounding_radius;
+        const float reach = world->shape_of(a).bounding_radius + world->shape_of(b).bounding_radius;
         if ((a.position - b.position).squaredNorm() <= reach * reach) want.emplace_back(i, j);
       }
     PairList got;
