@@ -181,8 +181,8 @@ void switch_broad_phase(WorldData<D>& w)
 template <int D>
 void find_pairs(WorldData<D>& w, StepResult& result)
 {
-  const bool grid = w.def.broad_phase == BroadPhase::grid ||
-                    (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies);
+  const bool grid = w.grid_storage && (w.def.broad_phase == BroadPhase::grid ||
+                                       (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies));
   std::uint32_t found = 0;
   if (grid != w.grid_layout) switch_broad_phase(w);
   if (grid) {

@@ -32,6 +32,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 
 namespace statsim {
@@ -58,10 +59,13 @@ class WorldCore {
   WorldCore& operator=(const WorldCore&) = delete;
 
   /// Replaces the world's parameters. Rejected with `invalid_parameter` (or `non_finite`) if any
-  /// is out of range; the world then keeps the parameters it had.
+  /// is out of range, or if it asks for `BroadPhase::grid` in a world that keeps storage for
+  /// sweep-and-prune only; the world then keeps the parameters it had.
   Status configure(const WorldDef<D>& def)
   {
-    const Status s = detail::check_world_def(def);
+    Status s = detail::check_world_def(def);
+    // A world without the grid's storage (`World`'s `Storage` parameter) cannot run it.
+    if (s == Status::ok && def.broad_phase == BroadPhase::grid && !w_.grid_storage) s = Status::invalid_parameter;
     if (s == Status::ok) {
       w_.def = def;
       w_.sweep_current = false;  // the sweep axis may have changed
@@ -329,13 +333,16 @@ class WorldCore {
   /// Storage a `World<>` hands to its core.
   struct Storage {
     Body<D>* bodies;
-    unsigned char* broad_phase;  ///< `detail::BroadPhaseLayout<D>::bytes(max_bodies)`, aligned for 16-byte records
+    /// `detail::BroadPhaseLayout<D>::bytes(max_bodies)`, aligned for 16-byte records; or, without
+    /// `grid_storage`, room for `max_bodies` sweep-and-prune entries only.
+    unsigned char* broad_phase;
     Pair* pairs;
     Plane<D>* planes;
     Shape<D>* shapes;
     std::uint32_t* awake;
     std::uint32_t* flagged;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
+    bool grid_storage;  ///< `broad_phase` holds the grid too
   };
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
@@ -345,10 +352,12 @@ class WorldCore {
            s.pairs,
            s.planes,
            s.shapes,
-           detail::SpatialHash<D>{
-               reinterpret_cast<std::uint32_t*>(s.broad_phase + detail::BroadPhaseLayout<D>::start(s.max_bodies)),
-               reinterpret_cast<detail::GridItem<D>*>(s.broad_phase + detail::BroadPhaseLayout<D>::items(s.max_bodies)),
-               detail::grid_buckets(s.max_bodies)},
+           s.grid_storage ? detail::SpatialHash<D>{reinterpret_cast<std::uint32_t*>(
+                                                       s.broad_phase + detail::BroadPhaseLayout<D>::start(s.max_bodies)),
+                                                   reinterpret_cast<detail::GridItem<D>*>(
+                                                       s.broad_phase + detail::BroadPhaseLayout<D>::items(s.max_bodies)),
+                                                   detail::grid_buckets(s.max_bodies)}
+                          : detail::SpatialHash<D>{nullptr, nullptr, 1},
            s.awake,
            s.flagged,
            s.max_bodies,
@@ -356,6 +365,7 @@ class WorldCore {
            s.max_planes,
            s.max_shapes}
   {
+    w_.grid_storage = s.grid_storage;
     construction_status_ = configure(def);
     if (construction_status_ == Status::ok && detail::float_contraction()) construction_status_ = Status::float_contraction;
   }
@@ -367,29 +377,18 @@ class WorldCore {
   std::uint16_t tag_ = detail::next_world_tag();
 };
 
-namespace detail {
-/// Storage of a World, a base class so that it is constructed before the core that points into it.
-template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes>
-struct WorldStorage {
-  std::array<Body<D>, MaxBodies> body_store;
-  alignas(16) std::array<unsigned char, detail::BroadPhaseLayout<D>::bytes(MaxBodies)> broad_phase_store;
-  std::array<Pair, MaxPairs> pair_store;
-  std::array<Plane<D>, MaxPlanes> plane_store;
-  std::array<Shape<D>, MaxShapes> shape_store;
-  std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
-  std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
-};
-}  // namespace detail
-
 /// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
 /// `overflow_pairs`) and `MaxShapes` shapes. All storage is inside the object: a large world
 /// belongs in static storage, not on the stack (10,000 bodies take about 2 MB with the default
-/// pair buffer).
+/// pair buffer). `Phases`: the broad phases the world keeps storage for, `automatic` (both) or
+/// `sweep_and_prune` (its entries only, for small worlds short of memory: `automatic` then
+/// always sweeps, and `WorldDef::broad_phase = grid` is refused).
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>, public WorldCore<D> {
-  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, BroadPhase Phases = BroadPhase::automatic>
+class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, Phases>,
+              public WorldCore<D> {
+  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, Phases>;
 
  public:
   static constexpr std::uint32_t max_bodies = MaxBodies;
@@ -398,6 +397,7 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   static constexpr std::uint32_t max_shapes = MaxShapes;
   static_assert(MaxBodies > 0 && MaxPlanes > 0 && MaxPairs > 0 && MaxShapes > 0, "capacities must be positive");
   static_assert(MaxShapes <= 65535 && MaxPlanes <= 65535, "shape and plane ids are 16-bit");
+  static_assert(Phases != BroadPhase::grid, "the grid's storage holds sweep-and-prune's too: use automatic");
 
   /// A world with the given parameters; if they are invalid it uses the defaults and
   /// `construction_status()` says why.
@@ -409,7 +409,7 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                                                      StorageBase::shape_store.data(),
                                                      StorageBase::awake_store.data(),
                                                      StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
-                                                     MaxShapes},
+                                                     MaxShapes, StorageBase::grid},
                      def)
   {
   }
@@ -420,11 +420,11 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
 /// position, a quaternion orientation and angular velocity vectors. Up is +z. See `World` for the
 /// capacities.
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, BroadPhase Phases = BroadPhase::automatic>
+using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, Phases>;
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8>
-using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes>;
+          std::uint32_t MaxShapes = 8, BroadPhase Phases = BroadPhase::automatic>
+using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, Phases>;
 using BodyDef2 = BodyDef<2>;
 using BodyDef3 = BodyDef<3>;
 using WorldDef2 = WorldDef<2>;

@@ -7,6 +7,8 @@
 #include "statsim/world_def.hpp"
 #include "statsim/random.hpp"
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace statsim {
@@ -85,10 +87,27 @@ struct WorldData {
   /// a sweep with no awake body would change nothing and find no pair.
   bool sweep_current = false;
   bool grid_layout = false;  ///< the broad phase's block holds the grid (see `entries`)
+  bool grid_storage = true;  ///< the block has room for the grid (`World`'s `Phases`)
   std::uint64_t step_count = 0;
   std::uint64_t energy_clamps = 0;  ///< over the world's life
   std::uint64_t statistical_responses = 0;  ///< over the world's life
   WorldDef<D> def{};
+};
+
+/// Storage of a World, a base class so that it is constructed before the core that points into it.
+template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes,
+          BroadPhase Phases>
+struct WorldStorage {
+  static constexpr bool grid = Phases != BroadPhase::sweep_and_prune;
+  static constexpr std::size_t broad_phase_bytes =
+      grid ? BroadPhaseLayout<D>::bytes(MaxBodies) : sizeof(SweepEntry) * std::size_t(MaxBodies);
+  std::array<Body<D>, MaxBodies> body_store;
+  alignas(16) std::array<unsigned char, broad_phase_bytes> broad_phase_store;
+  std::array<Pair, MaxPairs> pair_store;
+  std::array<Plane<D>, MaxPlanes> plane_store;
+  std::array<Shape<D>, MaxShapes> shape_store;
+  std::array<std::uint32_t, bit_words(MaxBodies)> awake_store;
+  std::array<std::uint32_t, bit_words(MaxBodies)> flagged_store;
 };
 
 /// What one step counts as its phases run; the passes reset the counter they test.

@@ -176,12 +176,13 @@ namespace {
 // A pile in which contacts move bodies: the order pairs are found in shapes the result, so equal
 // bits mean the same broad phase ran. Hashes the bodies only: `state_hash` also covers the
 // parameters, which differ between the worlds compared.
+template <class WorldT = World2<200>>
 std::uint64_t pile_hash(BroadPhase bp, std::uint32_t grid_above, std::uint32_t bodies)
 {
   WorldDef2 def;
   def.broad_phase = bp;
   def.grid_above_bodies = grid_above;
-  auto world = std::make_unique<World2<200>>(def);
+  auto world = std::make_unique<WorldT>(def);
   ShapeDef disc;
   disc.radius = 0.3f;
   disc.bounding_radius = 0.3f;
@@ -214,6 +215,23 @@ TEST_CASE("automatic broad phase: sweep-and-prune up to the threshold and the gr
   CHECK(pile_hash(BroadPhase::automatic, 120, 120) == sap);   // 120 bodies, not above 120
   CHECK(pile_hash(BroadPhase::automatic, 119, 120) == grid);  // above 119: the grid
   CHECK(WorldDef3{}.broad_phase == BroadPhase::automatic);
+}
+
+TEST_CASE("a world with storage for sweep-and-prune only: smaller, sweeps at any size, refuses the grid")
+{
+  using SweepOnly = World2<200, 8, 6 * 200, 8, BroadPhase::sweep_and_prune>;
+  CHECK(sizeof(SweepOnly) < sizeof(World2<200>));
+  const std::uint64_t sap = pile_hash(BroadPhase::sweep_and_prune, 2048, 120);
+  CHECK(pile_hash<SweepOnly>(BroadPhase::sweep_and_prune, 2048, 120) == sap);
+  CHECK(pile_hash<SweepOnly>(BroadPhase::automatic, 119, 120) == sap);  // with the grid's storage: the grid
+  WorldDef2 grid;
+  grid.broad_phase = BroadPhase::grid;
+  auto world = std::make_unique<SweepOnly>();
+  CHECK(world->configure(grid) == Status::invalid_parameter);
+  CHECK(world->def().broad_phase == BroadPhase::automatic);
+  auto refused = std::make_unique<SweepOnly>(grid);
+  CHECK(refused->construction_status() == Status::invalid_parameter);
+  CHECK(refused->def().broad_phase == BroadPhase::automatic);
 }
 
 TEST_CASE("pair buffer overflow is reported with the number dropped")
