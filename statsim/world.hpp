@@ -92,6 +92,7 @@ class WorldCore {
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, ShapeId{}};
     w_.shapes[w_.shape_count] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {},
                                          def.radius, 0, def.radius, 1, def.mass};
+    detail::note_bound(w_, bound);
     return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
   }
 
@@ -139,6 +140,7 @@ class WorldCore {
       shape.largest_packing = packing;
     }
     rest_basin_biases<D>(sig, shape.rest_bias.data());
+    detail::note_bound(w_, shape.bounding_radius);
     return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
   }
 

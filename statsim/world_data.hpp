@@ -83,6 +83,9 @@ struct WorldData {
   std::uint32_t touching_pairs = 0;  ///< last step's touching pairs, at the front of `pairs`
   std::uint32_t awake_count = 0;  ///< bodies not asleep
   Scalar widest = 0;  ///< the largest bounding diameter of the bodies, m
+  /// The bounding radius every shape of the world has, m, or 0 when they differ: the broad
+  /// phase's tests then need not look up the shapes of the bodies they compare.
+  Scalar common_bound = 0;
   /// The sweep-and-prune entries hold every body's interval, sorted, and no body has moved since:
   /// a sweep with no awake body would change nothing and find no pair.
   bool sweep_current = false;
@@ -122,6 +125,13 @@ struct StepContext {
   Scalar dt = 0;                    ///< the step's time step, s
   bool tilted_planes = false;       ///< `any_tilted_plane`: some contact may be on a slope
 };
+
+/// Records the bounding radius of a shape just added (`WorldData::common_bound`).
+template <int D>
+void note_bound(WorldData<D>& w, Scalar bound)
+{
+  w.common_bound = w.shape_count == 0 || bound == w.common_bound ? bound : Scalar(0);
+}
 
 /// Lever arm of a body in the particle response: its radius for a sphere; 0 for a statistical
 /// body, whose sphere is not its shape, so friction on the sphere must not spin it (a spin it

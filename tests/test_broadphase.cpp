@@ -217,6 +217,47 @@ TEST_CASE("automatic broad phase: sweep-and-prune up to the threshold and the gr
   CHECK(WorldDef3{}.broad_phase == BroadPhase::automatic);
 }
 
+TEST_CASE("world broad phase with shapes of different bounding radii: pairs equal brute force")
+{
+  for (BroadPhase bp : {BroadPhase::grid, BroadPhase::sweep_and_prune}) {
+    CAPTURE(int(bp));
+    WorldDef3 def;
+    def.gravity = Vector3::Zero();
+    def.broad_phase = bp;
+    auto world = std::make_unique<World3<300, 8, 3000>>(def);
+    ShapeDef large, small;
+    large.radius = small.radius = 1e-4f;  // no contact moves a body
+    large.bounding_radius = 0.35f;
+    small.bounding_radius = 0.12f;
+    const ShapeId shapes[2] = {world->add_shape(large).id, world->add_shape(small).id};
+    Pcg32 rng(23, 0);
+    for (int i = 0; i < 300; ++i) {
+      BodyDef3 b;
+      b.shape = shapes[i % 3 == 0 ? 0 : 1];
+      b.position = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-1, 1));
+      b.linear_velocity = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      REQUIRE(world->add_body(b).ok());
+    }
+    std::size_t total = 0;
+    for (int step = 0; step < 30; ++step) {
+      REQUIRE(world->step(1.0f / 60).ok());
+      PairList want;
+      for (std::uint32_t i = 0; i < world->body_count(); ++i)
+        for (std::uint32_t j = i + 1; j < world->body_count(); ++j) {
+          const Body3& a = world->body(i);
+          const Body3& b = world->body(j);
+          const float reach = world->shape_of(a).bounding_radius + world->shape_of(b).bounding_radius;
+          if ((a.position - b.position).squaredNorm() <= reach * reach) want.emplace_back(i, j);
+        }
+      PairList got;
+      for (std::uint32_t k = 0; k < world->pair_count(); ++k) got.emplace_back(world->pairs()[k].a, world->pairs()[k].b);
+      REQUIRE(sorted(got) == want);
+      total += want.size();
+    }
+    CHECK(total > 0);
+  }
+}
+
 TEST_CASE("a world with storage for sweep-and-prune only: smaller, sweeps at any size, refuses the grid")
 {
   using SweepOnly = World2<200, 8, 6 * 200, 8, BroadPhase::sweep_and_prune>;
