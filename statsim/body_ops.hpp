@@ -49,8 +49,7 @@ Added<BodyId> add_body(WorldData<D>& w, const BodyDef<D>& def)
   b.radius = shape.statistical
                  ? collision_radius<D>(shape.signature, b.linear_velocity, b.angular_velocity)
                  : shape.radius;
-  b.bounding_radius = shape.bounding_radius;
-  w.widest = 2 * b.bounding_radius > w.widest ? 2 * b.bounding_radius : w.widest;
+  w.widest = 2 * shape.bounding_radius > w.widest ? 2 * shape.bounding_radius : w.widest;
   b.inv_mass = Scalar(1) / mass;
   b.slow_time = 0;
   b.step_start = b.position;
@@ -90,10 +89,11 @@ Status remove_body(WorldData<D>& w, BodyId id)
   const std::uint32_t slot = find_slot(w, id);
   if (slot == no_slot) return Status::invalid_body;
   Body<D>& b = w.bodies[slot];
+  const Scalar bound = w.shapes[b.shape].bounding_radius;
   // Bodies resting on it touch it at their reach, give or take rounding: reaches grown by 1%.
   for (std::uint32_t j = 0; j < w.body_count; ++j) {
     Body<D>& o = w.bodies[j];
-    const Scalar reach = (b.bounding_radius + o.bounding_radius) * Scalar(1.01);
+    const Scalar reach = (bound + w.shapes[o.shape].bounding_radius) * Scalar(1.01);
     if (j != slot && o.state == MotionState::asleep && w.slots.live(j) &&
         (o.position - b.position).squaredNorm() <= reach * reach)
       wake(w, o);

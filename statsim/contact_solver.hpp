@@ -105,7 +105,7 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
     b.angular_velocity = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, def.rest_turn_time);
     // A small turn (paper 3.4): its farthest point moves at most at the settle speed, so a
     // slow body is not spun up (sin(angle) / rest_turn_time alone reaches 10 rad/s).
-    const Scalar cap = def.settle_speed / b.bounding_radius;
+    const Scalar cap = def.settle_speed / shape.bounding_radius;
     const Scalar spin2 = squared_norm(b.angular_velocity);
     if (spin2 > cap * cap) b.angular_velocity = b.angular_velocity * (cap / std::sqrt(spin2));
   } else {

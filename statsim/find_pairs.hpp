@@ -14,12 +14,14 @@ namespace statsim {
 namespace detail {
 
 /// Records a candidate pair if the bounding spheres overlap; counts it either way it fits.
+/// `common_reach`: twice `WorldData::common_bound` (the same sum as the two radii), or 0.
 template <int D>
-void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, std::uint32_t& found)
+void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_reach, std::uint32_t& found)
 {
   const Body<D>& ba = w.bodies[a];
   const Body<D>& bb = w.bodies[b];
-  const Scalar reach = ba.bounding_radius + bb.bounding_radius;
+  const Scalar reach = common_reach > 0 ? common_reach
+                                        : w.shapes[ba.shape].bounding_radius + w.shapes[bb.shape].bounding_radius;
   if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
   if (found < w.max_pairs) w.pairs[found] = a < b ? Pair{a, b} : Pair{b, a};
   ++found;
@@ -51,8 +53,10 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
   std::uint32_t found = 0, examined = 0;
   constexpr int neighbours = D == 3 ? 27 : 9;
   const Scalar half_cell = Scalar(0.5) * widest * grid.inv_cell;  // the widest bounding radius, in cells
+  const Scalar common = w.common_bound;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     const Body<D>& bi = w.bodies[i];
+    const Scalar bound_i = common > 0 ? common : w.shapes[bi.shape].bounding_radius;
     std::int32_t c[3];
     cell(i, c);
     // Where the body is in its cell, in cells: a neighbouring cell holds a body it can touch only
@@ -66,9 +70,9 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
       high[k] = 1 - low[k];
       margin += std::fabs(u) * Scalar(1e-6);
     }
-    const Scalar r = bi.bounding_radius * grid.inv_cell + half_cell + margin;
+    const Scalar r = bound_i * grid.inv_cell + half_cell + margin;
     const Scalar r2 = r * r;
-    const Scalar reach_max = bi.bounding_radius + Scalar(0.5) * widest;
+    const Scalar reach_max = bound_i + Scalar(0.5) * widest;
     const Scalar reach_max2 = reach_max * reach_max;
     // A bucket is searched once, where it first comes in the order of the cells, if any of
     // its cells is within reach: the pairs come in the same order as from searching them all.
@@ -111,7 +115,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
         const Scalar d2 = (it->position - bi.position).squaredNorm();
         if (d2 > reach_max2) continue;
         const std::uint32_t j = it->key & ~asleep_key;
-        const Scalar reach = bi.bounding_radius + w.bodies[j].bounding_radius;
+        const Scalar reach = bound_i + (common > 0 ? common : w.shapes[w.bodies[j].shape].bounding_radius);
         if (d2 > reach * reach) continue;
         if (found < w.max_pairs) w.pairs[found] = Pair{i < j ? i : j, i < j ? j : i};
         ++found;
@@ -134,14 +138,16 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   for (; w.entry_count < w.body_count; ++w.entry_count)
     new (&w.entries[w.entry_count]) SweepEntry{0, 0, w.entry_count, 1};
   const int axis = w.def.sweep_axis;
+  const Scalar common = w.common_bound;
   Scalar widest = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     SweepEntry& e = w.entries[i];
     const Body<D>& b = w.bodies[e.body];
-    e.lo = b.position[axis] - b.bounding_radius;
-    e.hi = b.position[axis] + b.bounding_radius;
+    const Scalar bound = common > 0 ? common : w.shapes[b.shape].bounding_radius;
+    e.lo = b.position[axis] - bound;
+    e.hi = b.position[axis] + bound;
     e.active = b.state != MotionState::asleep ? 1u : 0u;
-    widest = 2 * b.bounding_radius > widest ? 2 * b.bounding_radius : widest;
+    widest = 2 * bound > widest ? 2 * bound : widest;
   }
   result.broad_phase_bodies += w.body_count;
   insertion_sort(w.entries, w.body_count);
@@ -150,7 +156,9 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   // Its overlaps are not counted in `StepResult::pairs_examined`: a counter in the sweep's inner
   // loop costs it more than the count is worth.
   std::uint32_t found = 0;
-  sweep_active(w.entries, w.body_count, widest, [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, found); });
+  const Scalar common_reach = common + common;
+  sweep_active(w.entries, w.body_count, widest,
+               [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, common_reach, found); });
   return found;
 }
 
@@ -179,8 +187,8 @@ void switch_broad_phase(WorldData<D>& w)
 template <int D>
 void find_pairs(WorldData<D>& w, StepResult& result)
 {
-  const bool grid = w.def.broad_phase == BroadPhase::grid ||
-                    (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies);
+  const bool grid = w.grid_storage && (w.def.broad_phase == BroadPhase::grid ||
+                                       (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies));
   std::uint32_t found = 0;
   if (grid != w.grid_layout) switch_broad_phase(w);
   if (grid) {

@@ -263,7 +263,7 @@ bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, boo
   }
   const Vec d = b.position - a.position;
   const Scalar dist2 = d.squaredNorm();
-  const Scalar bound = a.bounding_radius + b.bounding_radius;
+  const Scalar bound = sa.bounding_radius + sb.bounding_radius;
   if (!(dist2 < bound * bound)) return false;
   const Scalar dist = std::sqrt(dist2);
   // Coincident centres: any direction is as good; up keeps it defined and deterministic.
@@ -306,7 +306,10 @@ Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
 template <int D>
 Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& plane)
 {
-  if (!(plane.normal.dot(b.position) - plane.offset < b.bounding_radius)) return b.radius;
+  // `hull_radius`'s first test, before the plane's distance: every body meets every plane in
+  // every pass, and most need neither.
+  if (w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling) return b.radius;
+  if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
   return hull_radius(w, b, plane.normal);
 }
 

@@ -118,9 +118,11 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
   const WorldDef<D>& def = w.def;
   const Scalar settle2 = def.settle_speed * def.settle_speed;
   const Scalar sleep2 = def.sleep_speed * def.sleep_speed;
+  const Scalar common = w.common_bound;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
-    const Scalar r2 = b.bounding_radius * b.bounding_radius;
+    const Scalar bound = common > 0 ? common : w.shapes[b.shape].bounding_radius;
+    const Scalar r2 = bound * bound;
     const Scalar v2 = b.linear_velocity.squaredNorm();
     // A body turning into its rest pose spins because the resting conditions make it: its
     // spin does not count against settling, and it sleeps once the pose is (nearly) reached.

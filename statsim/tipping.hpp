@@ -78,7 +78,7 @@ bool support_overhang(const Shape<D>& slo, const Body<D>& lo, const Shape<D>& su
   // Up's centre projected along n onto the plane, relative to lo's centre.
   const Vec c = d - n * d.dot(n);
   Vec axes[D == 3 ? 2 : 1];
-  contact_axes(n, x, Scalar(1e-6) * up.bounding_radius, axes);
+  contact_axes(n, x, Scalar(1e-6) * sup.bounding_radius, axes);
   pivot = lo.position + n * s_lo;
   overhang = Vec::Zero();
   for (const Vec& a : axes) {
@@ -165,7 +165,7 @@ void tip_over(const Shape<D>& shape, Body<D>& b, const typename Space<D>::Vec& p
   const Scalar drop = std::sqrt(r2) + r.dot(gravity_unit);
   if (!(drop > 0)) return;
   const std::array<Scalar, 3>& inertia = shape.signature.unit_inertia;
-  const Scalar cap = settle_speed / b.bounding_radius;
+  const Scalar cap = settle_speed / shape.bounding_radius;
   if constexpr (D == 3) {
     const Vector3 axis = r.cross(gravity_unit);
     const Scalar length = axis.norm();

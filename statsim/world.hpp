@@ -31,8 +31,10 @@
 #include "statsim/world_checks.hpp"
 #include "statsim/world_data.hpp"
 #include "statsim/world_def.hpp"
+#include "statsim/world_storage.hpp"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace statsim {
@@ -49,10 +51,13 @@ class WorldCore {
   WorldCore& operator=(const WorldCore&) = delete;
 
   /// Replaces the world's parameters. Rejected with `invalid_parameter` (or `non_finite`) if any
-  /// is out of range; the world then keeps the parameters it had.
+  /// is out of range, or if it asks for `BroadPhase::grid` in a world that keeps storage for
+  /// sweep-and-prune only; the world then keeps the parameters it had.
   Status configure(const WorldDef<D>& def)
   {
-    const Status s = detail::check_world_def(def);
+    Status s = detail::check_world_def(def);
+    // A world without the grid's storage (`World`'s `Storage` parameter) cannot run it.
+    if (s == Status::ok && def.broad_phase == BroadPhase::grid && !w_.grid_storage) s = Status::invalid_parameter;
     if (s == Status::ok) {
       w_.def = def;
       w_.sweep_current = false;  // the sweep axis may have changed
@@ -79,6 +84,7 @@ class WorldCore {
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, ShapeId{}};
     w_.shapes[w_.shape_count] = Shape<D>{def.radius, bound, def.material, false, SignatureView<D>{}, {},
                                          def.radius, 0, def.radius, 1, def.mass};
+    detail::note_bound(w_, bound);
     return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
   }
 
@@ -126,6 +132,7 @@ class WorldCore {
       shape.largest_packing = packing;
     }
     rest_basin_biases<D>(sig, shape.rest_bias.data());
+    detail::note_bound(w_, shape.bounding_radius);
     return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
   }
 
@@ -323,7 +330,9 @@ class WorldCore {
   /// Storage a `World<>` hands to its core.
   struct Storage {
     Body<D>* bodies;
-    unsigned char* broad_phase;  ///< `detail::BroadPhaseLayout<D>::bytes(max_bodies)`, aligned for 16-byte records
+    /// `detail::BroadPhaseLayout<D>::bytes(max_bodies)`, aligned for 16-byte records; or, without
+    /// `grid_storage`, room for `max_bodies` sweep-and-prune entries only.
+    unsigned char* broad_phase;
     Pair* pairs;
     Plane<D>* planes;
     Shape<D>* shapes;
@@ -334,6 +343,7 @@ class WorldCore {
     std::uint32_t max_impacts;
     std::uint16_t* generations;
     std::uint32_t* free_slots;
+    bool grid_storage;  ///< `broad_phase` holds the grid too
   };
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
@@ -343,10 +353,12 @@ class WorldCore {
            s.pairs,
            s.planes,
            s.shapes,
-           detail::SpatialHash<D>{
-               reinterpret_cast<std::uint32_t*>(s.broad_phase + detail::BroadPhaseLayout<D>::start(s.max_bodies)),
-               reinterpret_cast<detail::GridItem<D>*>(s.broad_phase + detail::BroadPhaseLayout<D>::items(s.max_bodies)),
-               detail::grid_buckets(s.max_bodies)},
+           s.grid_storage ? detail::SpatialHash<D>{reinterpret_cast<std::uint32_t*>(
+                                                       s.broad_phase + detail::BroadPhaseLayout<D>::start(s.max_bodies)),
+                                                   reinterpret_cast<detail::GridItem<D>*>(
+                                                       s.broad_phase + detail::BroadPhaseLayout<D>::items(s.max_bodies)),
+                                                   detail::grid_buckets(s.max_bodies)}
+                          : detail::SpatialHash<D>{nullptr, nullptr, 1},
            s.awake,
            s.flagged,
            s.max_bodies,
@@ -357,6 +369,7 @@ class WorldCore {
   {
     w_.slots.generation = s.generations;
     w_.slots.free = s.free_slots;
+    w_.grid_storage = s.grid_storage;
     construction_status_ = configure(def);
     if (construction_status_ == Status::ok && detail::float_contraction()) construction_status_ = Status::float_contraction;
   }
@@ -369,35 +382,19 @@ class WorldCore {
   std::uint16_t tag_ = detail::next_world_tag();
 };
 
-namespace detail {
-/// Storage of a World, a base class so that it is constructed before the core that points into it.
-template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes,
-          std::uint32_t MaxImpacts>
-struct WorldStorage {
-  std::array<Body<D>, MaxBodies> body_store;
-  alignas(16) std::array<unsigned char, detail::BroadPhaseLayout<D>::bytes(MaxBodies)> broad_phase_store;
-  std::array<Pair, MaxPairs> pair_store;
-  std::array<Plane<D>, MaxPlanes> plane_store;
-  std::array<Shape<D>, MaxShapes> shape_store;
-  std::array<std::uint32_t, detail::bit_words(MaxBodies)> awake_store;
-  std::array<std::uint32_t, detail::bit_words(MaxBodies)> flagged_store;
-  std::array<Impact<D>, MaxImpacts> impact_store;
-  std::array<std::uint16_t, MaxBodies> generation_store;
-  std::array<std::uint32_t, detail::bit_words(MaxBodies)> free_store;
-};
-}  // namespace detail
-
 /// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
 /// `overflow_pairs`), `MaxShapes` shapes and `MaxImpacts` impact events per step (0: none recorded,
 /// none reported). All storage is inside the object: a large world
 /// belongs in static storage, not on the stack (10,000 bodies take about 2 MB with the default
-/// pair buffer).
+/// pair buffer). `Phases`: the broad phases the world keeps storage for, `automatic` (both) or
+/// `sweep_and_prune` (its entries only, for small worlds short of memory: `automatic` then
+/// always sweeps, and `WorldDef::broad_phase = grid` is refused).
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
-class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>,
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic>
+class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>,
               public WorldCore<D> {
-  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
+  using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>;
 
  public:
   static constexpr std::uint32_t max_bodies = MaxBodies;
@@ -407,6 +404,7 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   static_assert(MaxBodies > 0 && MaxPlanes > 0 && MaxPairs > 0 && MaxShapes > 0, "capacities must be positive");
   static_assert(MaxShapes <= 65535 && MaxPlanes < 65535, "shape and plane ids are 16-bit");
   static_assert(MaxBodies <= 1u << body_index_bits, "body ids hold the slot in body_index_bits bits");
+  static_assert(Phases != BroadPhase::grid, "the grid's storage holds sweep-and-prune's too: use automatic");
 
   /// A world with the given parameters; if they are invalid it uses the defaults and
   /// `construction_status()` says why.
@@ -420,7 +418,7 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                                                      StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
                                                      MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
                                                      StorageBase::generation_store.data(),
-                                                     StorageBase::free_store.data()},
+                                                     StorageBase::free_store.data(), StorageBase::grid},
                      def)
   {
   }
@@ -431,11 +429,11 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
 /// position, a quaternion orientation and angular velocity vectors. Up is +z. See `World` for the
 /// capacities.
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
-using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic>
+using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>;
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0>
-using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic>
+using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>;
 using BodyDef2 = BodyDef<2>;
 using BodyDef3 = BodyDef<3>;
 using WorldDef2 = WorldDef<2>;

@@ -8,6 +8,8 @@
 #include "statsim/world_ids.hpp"
 #include "statsim/random.hpp"
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace statsim {
@@ -82,10 +84,14 @@ struct WorldData {
   std::uint32_t touching_pairs = 0;  ///< last step's touching pairs, at the front of `pairs`
   std::uint32_t awake_count = 0;  ///< bodies not asleep
   Scalar widest = 0;  ///< the largest bounding diameter of the bodies, m
+  /// The bounding radius every shape of the world has, m, or 0 when they differ: the broad
+  /// phase's tests then need not look up the shapes of the bodies they compare.
+  Scalar common_bound = 0;
   /// The sweep-and-prune entries hold every body's interval, sorted, and no body has moved since:
   /// a sweep with no awake body would change nothing and find no pair.
   bool sweep_current = false;
   bool grid_layout = false;  ///< the broad phase's block holds the grid (see `entries`)
+  bool grid_storage = true;  ///< the block has room for the grid (`World`'s `Phases`)
   std::uint64_t step_count = 0;
   std::uint64_t energy_clamps = 0;  ///< over the world's life
   std::uint64_t statistical_responses = 0;  ///< over the world's life
@@ -105,6 +111,13 @@ struct StepContext {
   Scalar dt = 0;                    ///< the step's time step, s
   bool tilted_planes = false;       ///< `any_tilted_plane`: some contact may be on a slope
 };
+
+/// Records the bounding radius of a shape just added (`WorldData::common_bound`).
+template <int D>
+void note_bound(WorldData<D>& w, Scalar bound)
+{
+  w.common_bound = w.shape_count == 0 || bound == w.common_bound ? bound : Scalar(0);
+}
 
 /// Lever arm of a body in the particle response: its radius for a sphere; 0 for a statistical
 /// body, whose sphere is not its shape, so friction on the sphere must not spin it (a spin it
@@ -237,7 +250,8 @@ std::uint64_t state_hash(const WorldData<D>& w)
     h.add_rot(b.orientation);
     h.add_vec(b.linear_velocity);
     h.add_spin(b.angular_velocity);
-    h.add_all(b.radius, b.bounding_radius, b.inv_mass, b.slow_time, b.rng_state, b.rest_blend, b.shape,
+    h.add_all(b.radius, w.shapes[b.shape].bounding_radius, b.inv_mass, b.slow_time, std::uint64_t(b.rng_state),
+              b.rest_blend, b.shape,
               std::uint8_t(b.state), std::uint8_t(b.touching), std::uint8_t(b.on_ground), b.rest_pose,
               std::uint8_t(b.pile_rest));
   }

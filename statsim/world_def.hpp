@@ -235,21 +235,39 @@ struct WorldDef {
   Scalar impact_threshold = 1;
 };
 
+/// A 64-bit word kept as two 32-bit halves, so that it needs only 4-byte alignment: a body's
+/// random state then packs after its 4-byte fields without padding (a 2D body would otherwise
+/// grow by 4 bytes to the next multiple of 8). Reads and writes as a `std::uint64_t`.
+struct Word64 {
+  std::uint32_t lo;
+  std::uint32_t hi;
+  constexpr operator std::uint64_t() const { return std::uint64_t(hi) << 32 | lo; }
+  constexpr Word64& operator=(std::uint64_t x)
+  {
+    lo = std::uint32_t(x);
+    hi = std::uint32_t(x >> 32);
+    return *this;
+  }
+};
+
 /// Full state of a body. Read it through `WorldCore::body()`; change it only through the world.
+/// The orientation comes first: a quaternion is 16-byte aligned, and after it the fields pack
+/// without padding. The bounding radius is the
+/// shape's (`Shape::bounding_radius`, `WorldCore::shape_of`): it is the same for every body of a
+/// shape, so a body does not keep a copy.
 template <int D>
 struct Body {
   using Vec = typename Space<D>::Vec;
-  Vec position;                           ///< centre of mass, m
   typename Space<D>::Rot orientation;     ///< body to world, unit
+  Vec position;                           ///< centre of mass, m
   Vec linear_velocity;                    ///< m/s
   typename Space<D>::Spin angular_velocity;  ///< rad/s
+  Vec step_start;                         ///< m, centre at the start of the last step (for the sleep test)
   Scalar radius;                          ///< current collision radius, m
-  Scalar bounding_radius;                 ///< m
   Scalar inv_mass;                        ///< 1/kg
   Scalar slow_time;                       ///< s spent slow and touching
-  Vec step_start;                         ///< m, centre at the start of the last step (for the sleep test)
-  std::uint64_t rng_state;                ///< state of the body's PCG32 stream
   Scalar rest_blend;                      ///< 0: radius is h_coll; 1: radius is h_rest of rest_pose
+  Word64 rng_state;                       ///< state of the body's PCG32 stream
   std::uint16_t shape;                    ///< index of the body's shape (`ShapeId::index`)
   MotionState state;
   bool touching;                          ///< touched a plane or body in the last step

@@ -160,7 +160,7 @@ TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skip
         const Body3& a = world->body(i);
         const Body3& b = world->body(j);
         if (a.state == MotionState::asleep && b.state == MotionState::asleep) continue;
-        const float reach = a.bounding_radius + b.bounding_radius;
+        const float reach = world->shape_of(a).bounding_radius + world->shape_of(b).bounding_radius;
         if ((a.position - b.position).squaredNorm() <= reach * reach) want.emplace_back(i, j);
       }
     PairList got;
@@ -176,12 +176,13 @@ namespace {
 // A pile in which contacts move bodies: the order pairs are found in shapes the result, so equal
 // bits mean the same broad phase ran. Hashes the bodies only: `state_hash` also covers the
 // parameters, which differ between the worlds compared.
+template <class WorldT = World2<200>>
 std::uint64_t pile_hash(BroadPhase bp, std::uint32_t grid_above, std::uint32_t bodies)
 {
   WorldDef2 def;
   def.broad_phase = bp;
   def.grid_above_bodies = grid_above;
-  auto world = std::make_unique<World2<200>>(def);
+  auto world = std::make_unique<WorldT>(def);
   ShapeDef disc;
   disc.radius = 0.3f;
   disc.bounding_radius = 0.3f;
@@ -214,6 +215,64 @@ TEST_CASE("automatic broad phase: sweep-and-prune up to the threshold and the gr
   CHECK(pile_hash(BroadPhase::automatic, 120, 120) == sap);   // 120 bodies, not above 120
   CHECK(pile_hash(BroadPhase::automatic, 119, 120) == grid);  // above 119: the grid
   CHECK(WorldDef3{}.broad_phase == BroadPhase::automatic);
+}
+
+TEST_CASE("world broad phase with shapes of different bounding radii: pairs equal brute force")
+{
+  for (BroadPhase bp : {BroadPhase::grid, BroadPhase::sweep_and_prune}) {
+    CAPTURE(int(bp));
+    WorldDef3 def;
+    def.gravity = Vector3::Zero();
+    def.broad_phase = bp;
+    auto world = std::make_unique<World3<300, 8, 3000>>(def);
+    ShapeDef large, small;
+    large.radius = small.radius = 1e-4f;  // no contact moves a body
+    large.bounding_radius = 0.35f;
+    small.bounding_radius = 0.12f;
+    const ShapeId shapes[2] = {world->add_shape(large).id, world->add_shape(small).id};
+    Pcg32 rng(23, 0);
+    for (int i = 0; i < 300; ++i) {
+      BodyDef3 b;
+      b.shape = shapes[i % 3 == 0 ? 0 : 1];
+      b.position = Vector3(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-1, 1));
+      b.linear_velocity = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      REQUIRE(world->add_body(b).ok());
+    }
+    std::size_t total = 0;
+    for (int step = 0; step < 30; ++step) {
+      REQUIRE(world->step(1.0f / 60).ok());
+      PairList want;
+      for (std::uint32_t i = 0; i < world->body_count(); ++i)
+        for (std::uint32_t j = i + 1; j < world->body_count(); ++j) {
+          const Body3& a = world->body(i);
+          const Body3& b = world->body(j);
+          const float reach = world->shape_of(a).bounding_radius + world->shape_of(b).bounding_radius;
+          if ((a.position - b.position).squaredNorm() <= reach * reach) want.emplace_back(i, j);
+        }
+      PairList got;
+      for (std::uint32_t k = 0; k < world->pair_count(); ++k) got.emplace_back(world->pairs()[k].a, world->pairs()[k].b);
+      REQUIRE(sorted(got) == want);
+      total += want.size();
+    }
+    CHECK(total > 0);
+  }
+}
+
+TEST_CASE("a world with storage for sweep-and-prune only: smaller, sweeps at any size, refuses the grid")
+{
+  using SweepOnly = World2<200, 8, 6 * 200, 8, 0, BroadPhase::sweep_and_prune>;
+  CHECK(sizeof(SweepOnly) < sizeof(World2<200>));
+  const std::uint64_t sap = pile_hash(BroadPhase::sweep_and_prune, 2048, 120);
+  CHECK(pile_hash<SweepOnly>(BroadPhase::sweep_and_prune, 2048, 120) == sap);
+  CHECK(pile_hash<SweepOnly>(BroadPhase::automatic, 119, 120) == sap);  // with the grid's storage: the grid
+  WorldDef2 grid;
+  grid.broad_phase = BroadPhase::grid;
+  auto world = std::make_unique<SweepOnly>();
+  CHECK(world->configure(grid) == Status::invalid_parameter);
+  CHECK(world->def().broad_phase == BroadPhase::automatic);
+  auto refused = std::make_unique<SweepOnly>(grid);
+  CHECK(refused->construction_status() == Status::invalid_parameter);
+  CHECK(refused->def().broad_phase == BroadPhase::automatic);
 }
 
 TEST_CASE("pair buffer overflow is reported with the number dropped")

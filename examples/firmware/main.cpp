@@ -82,12 +82,12 @@ namespace {
 constexpr std::uint32_t bodies = FIRMWARE_BODIES;
 constexpr int steps = FIRMWARE_STEPS;
 constexpr statsim::Scalar dt = statsim::Scalar(1) / 60;
-// Candidate pairs per body (the broad phase pairs bounding spheres): a bunny's bounding radius is
-// over twice the height it rests at, so a pile of bunnies has far more candidate pairs per body
-// than a pile of boxes (measured peaks: examples/firmware/README.md); boxes and L-shapes that touch
-// at their hulls stand nearer than their bounding spheres, so their piles have about as many. A
-// step reports an overflow, and this program then fails.
-constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 2 ? 8 : 5) * bodies;
+// Candidate pairs per body (the broad phase pairs bounding spheres), each shape's measured peak
+// with a margin (examples/firmware/README.md): a bunny's bounding radius is over twice the height
+// it rests at, so a pile of bunnies has far more candidate pairs per body than a pile of boxes;
+// an L-shape's bounding sphere reaches far past its arms. A step reports an overflow, and this
+// program then fails.
+constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 2 ? 8 : (FIRMWARE_SHAPE == 1 ? 5 : 4)) * bodies;
 constexpr std::uint32_t pairs2 = 3 * bodies;
 // Scenes that grow with the body count: columns of bodies four high in 3D (k x k columns, k a
 // multiple of 4) and eight high in 2D.
@@ -165,9 +165,12 @@ void on_assert(const char* expression, const char* file, int line)
 }
 
 // The worlds live in static storage: constructed by the start-up code before main, no heap.
-statsim::World3<bodies, 8, pairs3, 2> world3;
-statsim::World2<bodies, 8, pairs2, 2> world2;
-statsim::World3<model_bodies, 1, 4 * model_bodies, 2> world_models;
+// Up to `WorldDef::grid_above_bodies` (2,048 by default) bodies a world sweeps, so these keep
+// storage for sweep-and-prune only.
+constexpr statsim::BroadPhase sweep_only = statsim::BroadPhase::sweep_and_prune;
+statsim::World3<bodies, 8, pairs3, 2, 0, sweep_only> world3;
+statsim::World2<bodies, 8, pairs2, 2, 0, sweep_only> world2;
+statsim::World3<model_bodies, 1, 4 * model_bodies, 2, 0, sweep_only> world_models;
 
 /// A unit quaternion from four uniform draws (normalising a random 4-vector; no trigonometry).
 statsim::Quaternion random_orientation(statsim::Pcg32& rng)
