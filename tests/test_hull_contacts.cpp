@@ -40,7 +40,8 @@ void pile_state(const World& w, Scalar& overlap, Scalar& lowest)
       const Scalar dist = d.norm();
       const Vec e = d / dist;
       const Scalar packing = sa.largest_packing > sb.largest_packing ? sa.largest_packing : sb.largest_packing;
-      const std::uint32_t k = detail::find_hull_witness(sa, a, sb, b, e, dist, packing);
+      const std::uint32_t k =
+          detail::find_hull_witness(sa, a, sb, b, e, dist, packing, detail::pair_packing(sa, sb, a.shape == b.shape, e));
       if (k == detail::no_witness) continue;
       const detail::HullCandidate<D> h = detail::hull_candidate(sa, a, sb, b, e, k);
       const Scalar reach = (k == 0 ? detail::pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
@@ -219,5 +220,50 @@ TEST_CASE("hull contacts: 2D, a square whose centre lies beyond the edge of the 
       CHECK(top.position.y() < Scalar(0.55));
       CHECK(top.position.x() > Scalar(1));
     }
+  }
+}
+
+TEST_CASE("hull contacts: the distance at which two L-shapes touch changes continuously as one turns")
+{
+  // The runtime's own contact test (detail::body_contact, as the impact pass calls it) on two
+  // L-shapes, the second turned in steps of 0.2 degrees: the largest separation along a fixed
+  // line of centres at which they touch, found by bisection, may change by no more than a turn
+  // of 0.2 degrees moves the body (its bounding radius times the angle, with margin). A packing
+  // ratio taken from whichever candidate the hulls alone pick jumps where the pick changes
+  // between a face that spans the L's hollow and one that does not.
+  WorldDef2 def;
+  def.body_contacts = BodyContacts::hulls;
+  auto world = std::make_unique<World2<2>>(def);
+  const ShapeId l = world->add_shape(tables::lshape2d.view()).id;
+  BodyDef2 bd;
+  bd.shape = l;
+  bd.mass = 1;
+  REQUIRE(world->add_body(bd).status == Status::ok);
+  detail::WorldData<2> w{};
+  w.def = def;
+  Shape<2> shapes[1] = {world->shape(l)};
+  w.shapes = shapes;
+  Body<2> a = world->body(0), b = world->body(0);
+  const Scalar bound = a.bounding_radius + b.bounding_radius;
+  const Scalar turn = Scalar(0.2) * Scalar(3.14159265) / 180;
+  for (const Scalar phi : {Scalar(0), Scalar(0.7), Scalar(2.1)}) {
+    CAPTURE(phi);
+    const Vector2 e(std::cos(phi), std::sin(phi));
+    Scalar last = -1, jump = 0;
+    for (int k = 0; k < 1800; ++k) {
+      b.orientation = Rot2::from_angle(turn * Scalar(k));
+      Scalar lo = 0, hi = bound;
+      for (int it = 0; it < 40; ++it) {
+        const Scalar mid = Scalar(0.5) * (lo + hi);
+        b.position = a.position + e * mid;
+        Pair pair{0, 1};
+        Contact<2> c;
+        Scalar reach, slop;
+        (detail::body_contact(w, a, b, pair, true, Scalar(0), c, reach, slop) ? lo : hi) = mid;
+      }
+      if (last >= 0) jump = std::fabs(lo - last) > jump ? std::fabs(lo - last) : jump;
+      last = lo;
+    }
+    CHECK(jump < Scalar(3) * b.bounding_radius * turn);
   }
 }
