@@ -142,10 +142,13 @@ std::uint32_t integrate(WorldData<D>& w, Scalar dt)
   const Vec dv = w.def.gravity * dt;
   const Scalar lin_damp = Scalar(1) / (1 + dt * w.def.linear_damping);
   const Scalar ang_damp = Scalar(1) / (1 + dt * w.def.angular_damping);
+  const bool anchored = w.def.body_contacts == BodyContacts::hulls;
   std::uint32_t count = 0;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
-    b.step_start = b.position;
+    // With hull contacts the sleep test measures from where the body's slow time began
+    // (`detail::update_motion_states`): the centre is kept there while the clock runs.
+    if (!anchored || b.slow_time == 0) b.step_start = b.position;
     b.linear_velocity = (b.linear_velocity + dv) * lin_damp;
     b.angular_velocity = b.angular_velocity * ang_damp;
     b.position += b.linear_velocity * dt;

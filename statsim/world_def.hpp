@@ -227,7 +227,9 @@ struct Body {
   Scalar bounding_radius;                 ///< m
   Scalar inv_mass;                        ///< 1/kg
   Scalar slow_time;                       ///< s spent slow and touching
-  Vec step_start;                         ///< m, centre at the start of the last step (for the sleep test)
+  /// m, centre at the start of the last step, or with `BodyContacts::hulls` where the body's slow
+  /// time began (for the sleep test)
+  Vec step_start;
   std::uint64_t rng_state;                ///< state of the body's PCG32 stream
   Scalar rest_blend;                      ///< 0: radius is h_coll; 1: radius is h_rest of rest_pose
   std::uint16_t shape;                    ///< index of the body's shape (`ShapeId::index`)
