@@ -145,10 +145,10 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     // With hull contacts a body held by several neighbours can also cycle over a few steps: it
     // slides down one neighbour's face into another, whose overlap correction lifts it back, at a
     // velocity above the sleep speed in every step and without going anywhere. Its centre is
-    // measured from where its slow time began (`integrate` keeps it there): it is still while it
-    // stays within the distance a body at the sleep speed covers in the sleep time,
-    // |x - x_0| < v_sleep t_sleep, as well as while it is slower than the sleep speed.
-    if (def.body_contacts == BodyContacts::hulls) {
+    // measured from where its slow time began (`sleeps_from_anchor`; `integrate` keeps it there):
+    // it is still while it stays within the distance a body at the sleep speed covers in the
+    // sleep time, |x - x_0| < v_sleep t_sleep, as well as while it is slower than the sleep speed.
+    if (sleeps_from_anchor(w, b)) {
       const Scalar reach = def.sleep_speed * def.sleep_time;
       if (moved2 < reach * reach) lin2 = 0;
     }
