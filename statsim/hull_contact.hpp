@@ -11,14 +11,20 @@
 /// exactly at the contact normal when it is among the candidates. Candidates: e itself and
 /// the stored faces of either body (n = R_a f, or n = -R_b g), whose own support is their offset
 /// exactly; the other body's support comes from its support map, which never reads below the
-/// hull's. A pair touches when |c_b - c_a| < p d(e), p the packing ratio of the shapes (how much
-/// nearer than their hulls allow neighbours rest in reference piles; 1 for convex shapes), and
-/// the contact is taken along the minimising candidate n*, with the separation it needs
-/// target = p [s_a(n*) + s_b(-n*)]: so a box resting on two offset boxes is held along their
-/// faces' normal, not pushed sideways along the line of centres. p is measured per candidate:
-/// a face of the shape itself holds its neighbour at the hull (p = 1), a hull face that spans a
-/// hollow lets it nest (p < 1), and a contact along the line of centres takes the ratio for its
-/// angle to the vertical.
+/// hull's. Each candidate k carries a packing ratio p_k (how much nearer than their hulls allow
+/// neighbours rest in reference piles): a face of the shape itself holds its neighbour at the
+/// hull (p = 1), a hull face that spans a hollow lets it nest (p < 1), and a contact along the
+/// line of centres takes the ratio for its angle to the vertical. A pair touches when
+///     |c_b - c_a| < min over k of p_k d_k(e),   d_k(e) = [s_a(n_k) + s_b(-n_k)] / (n_k.e),
+/// and the contact is taken along the minimising candidate n*, with the separation it needs
+/// target = p* [s_a(n*) + s_b(-n*)]: so a box resting on two offset boxes is held along their
+/// faces' normal, not pushed sideways along the line of centres. The minimum is over the packed
+/// distances, not the ratio of the geometric minimum: each p_k d_k changes continuously as the
+/// bodies move and turn, and so does their minimum, where the ratio of whichever candidate is
+/// geometrically least jumps when that candidate changes (for an L-shape from 0.7 to 1, a
+/// third of the distance): a body nested along one face would be thrown out of the hollow by
+/// the overlap correction as soon as another face became the least, fall back and be thrown
+/// again, never coming to rest.
 ///
 /// Cost per pair: two rotations and two map reads for e, then per face with n.e > 0 that can
 /// still beat the best candidate one rotation, one map read and one division; a fixed bound, no
@@ -185,14 +191,17 @@ Scalar largest_packing(const Shape<D>& s)
 }
 
 /// The hull contact of a pair whose centres are `d` apart (d = c_b - c_a, |d| = `dist` > 0,
-/// e = d / dist): the candidate with the least distance along e (the hulls' geometry alone),
-/// or `no_witness` when the pair is surely apart: farther than that distance times `packing`,
-/// the largest packing ratio either shape has.
+/// e = d / dist): the candidate with the least packed distance along e, p_k d_k(e), where
+/// `line_packing` > 0 is the ratio along e itself (`pair_packing`), or with `line_packing` = 0
+/// the least distance of the hulls' geometry alone (p_k = 1: what the gatherers measure packing
+/// against); `no_witness` when the pair is apart: at least that distance away, or (first, from
+/// e alone) farther than the distance along e times `packing`, the largest packing ratio either
+/// shape has.
 constexpr std::uint32_t no_witness = 0xffffffffu;
 
 template <int D>
 std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, const Body<D>& b,
-                                const typename Space<D>::Vec& e, Scalar dist, Scalar packing)
+                                const typename Space<D>::Vec& e, Scalar dist, Scalar packing, Scalar line_packing = 0)
 {
   using Vec = typename Space<D>::Vec;
   constexpr std::uint32_t fv = face_values(D);
@@ -201,9 +210,12 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
   const Vec ea = to_body(a.orientation, e), eb = to_body(b.orientation, e);
   Scalar best = shape_support(sa, ea) + shape_support(sb, Vec(-eb));
   if (!(dist < packing * best)) return no_witness;
+  const bool packed = line_packing > 0;
+  if (packed) best *= line_packing;
   std::uint32_t witness = 0;
-  // A face of a with offset o and n.e = c gives at least (o + floor_b) / c, floor_b the least
-  // support b's map can return: faces that cannot beat the best so far are skipped unread.
+  // A face of a with offset o, packing ratio p and n.e = c gives at least p (o + floor_b) / c,
+  // floor_b the least support b's map can return: faces that cannot beat the best so far are
+  // skipped unread.
   const Scalar floor_a = sa.statistical ? sa.support_floor : sa.radius;
   const Scalar floor_b = sb.statistical ? sb.support_floor : sb.radius;
   const std::uint32_t ka = sa.statistical ? sa.signature.contact.face_count : 0u;
@@ -211,9 +223,10 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
   for (std::uint32_t i = 0; i < ka; ++i) {
     const Scalar* f = sa.signature.contact.faces + i * fv;
     const Scalar c = Vec(Eigen::Map<const Vec>(f)).dot(ea);
-    if (!(c > 0) || !(f[D] + floor_b < best * c)) continue;
+    const Scalar pf = packed ? f[D + 1] : Scalar(1);
+    if (!(c > 0) || !(pf * (f[D] + floor_b) < best * c)) continue;
     const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
-    const Scalar along = (f[D] + shape_support(sb, to_body(b.orientation, Vec(-n)))) / c;
+    const Scalar along = pf * ((f[D] + shape_support(sb, to_body(b.orientation, Vec(-n)))) / c);
     if (!(along > best)) {
       best = along;
       witness = 1 + i;
@@ -222,15 +235,16 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
   for (std::uint32_t i = 0; i < kb; ++i) {
     const Scalar* g = sb.signature.contact.faces + i * fv;
     const Scalar c = -Vec(Eigen::Map<const Vec>(g)).dot(eb);
-    if (!(c > 0) || !(g[D] + floor_a < best * c)) continue;
+    const Scalar pg = packed ? g[D + 1] : Scalar(1);
+    if (!(c > 0) || !(pg * (g[D] + floor_a) < best * c)) continue;
     const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
-    const Scalar along = (shape_support(sa, to_body(a.orientation, n)) + g[D]) / c;
+    const Scalar along = pg * ((shape_support(sa, to_body(a.orientation, n)) + g[D]) / c);
     if (!(along > best)) {
       best = along;
       witness = 1 + ka + i;
     }
   }
-  return dist < packing * best ? witness : no_witness;
+  return dist < (packed ? best : packing * best) ? witness : no_witness;
 }
 
 /// True when two bodies touch at their hulls (`BodyContacts::hulls`, both shapes with a hull, at
@@ -271,7 +285,8 @@ bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, boo
   if (fresh) {
     const Scalar pa = sa.statistical ? sa.largest_packing : Scalar(1);
     const Scalar pb = sb.statistical ? sb.largest_packing : Scalar(1);
-    pair.witness = find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb);
+    pair.witness = find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb,
+                                     pair_packing(sa, sb, a.shape == b.shape, e));
     if (pair.witness == no_witness) return false;
   } else if (pair.witness == no_witness) {
     return false;

@@ -143,7 +143,17 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     // step moves the body into them and the shock pass moves it back, a cycle in which it
     // never moves and never sleeps (tools/ref2d/README.md shows how often in a pile).
     const Scalar moved2 = (b.position - b.step_start).squaredNorm();
-    const Scalar lin2 = moved2 < v2 * dt * dt ? moved2 / (dt * dt) : v2;
+    Scalar lin2 = moved2 < v2 * dt * dt ? moved2 / (dt * dt) : v2;
+    // With hull contacts a body held by several neighbours can also cycle over a few steps: it
+    // slides down one neighbour's face into another, whose overlap correction lifts it back, at a
+    // velocity above the sleep speed in every step and without going anywhere. Its centre is
+    // measured from where its slow time began (`sleeps_from_anchor`; `integrate` keeps it there):
+    // it is still while it stays within the distance a body at the sleep speed covers in the
+    // sleep time, |x - x_0| < v_sleep t_sleep, as well as while it is slower than the sleep speed.
+    if (sleeps_from_anchor(w, b)) {
+      const Scalar reach = def.sleep_speed * def.sleep_time;
+      if (moved2 < reach * reach) lin2 = 0;
+    }
     // It turns at ground contacts: one that keeps its pose while held up by other bodies cannot
     // reach it there, and may sleep where it is.
     const bool posed = !turning || !b.on_ground || in_rest_pose(w, b, ground);

@@ -147,6 +147,16 @@ void wake(WorldData<D>& w, Body<D>& b)
   b.step_start = b.position;  // a sleeper is not integrated: this is where it started the step
 }
 
+/// True when the sleep test measures the body's centre from where its slow time began
+/// (`update_motion_states`): with hull contacts, for a shape whose table has body-body data (an
+/// older table steps exactly as with collision spheres).
+template <int D>
+bool sleeps_from_anchor(const WorldData<D>& w, const Body<D>& b)
+{
+  const Shape<D>& s = w.shapes[b.shape];
+  return w.def.body_contacts == BodyContacts::hulls && s.statistical && s.signature.contact.present();
+}
+
 /// Semi-implicit Euler for awake bodies: gravity and damping change the velocity, which then
 /// moves the body; orientation without trigonometry (`detail::integrate`). Returns the number of
 /// bodies integrated.
@@ -157,10 +167,13 @@ std::uint32_t integrate(WorldData<D>& w, Scalar dt)
   const Vec dv = w.def.gravity * dt;
   const Scalar lin_damp = Scalar(1) / (1 + dt * w.def.linear_damping);
   const Scalar ang_damp = Scalar(1) / (1 + dt * w.def.angular_damping);
+  const bool hulls = w.def.body_contacts == BodyContacts::hulls;
   std::uint32_t count = 0;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
-    b.step_start = b.position;
+    // The sleep test may measure from where the body's slow time began (`sleeps_from_anchor`):
+    // the centre is kept there while the clock runs.
+    if (b.slow_time == 0 || !hulls || !sleeps_from_anchor(w, b)) b.step_start = b.position;
     b.linear_velocity = (b.linear_velocity + dv) * lin_damp;
     b.angular_velocity = b.angular_velocity * ang_damp;
     b.position += b.linear_velocity * dt;

@@ -262,7 +262,9 @@ struct Body {
   Vec position;                           ///< centre of mass, m
   Vec linear_velocity;                    ///< m/s
   typename Space<D>::Spin angular_velocity;  ///< rad/s
-  Vec step_start;                         ///< m, centre at the start of the last step (for the sleep test)
+  /// m, centre at the start of the last step, or with `BodyContacts::hulls` where the body's slow
+  /// time began (for the sleep test)
+  Vec step_start;
   Scalar radius;                          ///< current collision radius, m
   Scalar inv_mass;                        ///< 1/kg
   Scalar slow_time;                       ///< s spent slow and touching
