@@ -26,6 +26,7 @@
 #include "statsim/contact_solver.hpp"
 #include "statsim/find_pairs.hpp"
 #include "statsim/rest_and_sleep.hpp"
+#include "statsim/signature_scale.hpp"
 #include "statsim/world_checks.hpp"
 #include "statsim/world_data.hpp"
 #include "statsim/world_def.hpp"
@@ -136,6 +137,15 @@ class WorldCore {
     }
     rest_basin_biases<D>(sig, shape.rest_bias.data());
     return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
+  }
+
+  /// A statistical shape `scale` times its table's size (`scaled_view`; 1: `add_shape(sig)` bit for bit).
+  /// Rejected with `non_finite`, `out_of_range` (outside [`min_shape_scale`, `max_shape_scale`]), or as above.
+  Added<ShapeId> add_shape(const SignatureView<D>& sig, Scalar scale)
+  {
+    if (!std::isfinite(scale)) return {Status::non_finite, ShapeId{}};
+    if (!(scale >= min_shape_scale && scale <= max_shape_scale)) return {Status::out_of_range, ShapeId{}};
+    return add_shape(scaled_view(sig, scale));
   }
 
   /// Adds a static plane with the given normal (any length > 0; it is normalised) through the
