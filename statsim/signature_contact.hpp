@@ -27,7 +27,12 @@ struct ValuesView {
       : f32(f), i16(q), scale(s), offset(o)
   {
   }
-  Scalar operator[](std::uint32_t i) const { return f32 ? f32[i] * scale : offset + scale * Scalar(i16[i]); }
+  /// Value i (any integer index, as a pointer takes).
+  template <class Index>
+  Scalar operator[](Index i) const
+  {
+    return f32 ? f32[i] * scale : offset + scale * Scalar(i16[i]);
+  }
   friend constexpr bool operator==(const ValuesView& v, std::nullptr_t) { return !v.f32 && !v.i16; }
   friend constexpr bool operator!=(const ValuesView& v, std::nullptr_t) { return v.f32 || v.i16; }
 };
