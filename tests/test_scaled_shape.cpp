@@ -128,7 +128,8 @@ TEST_CASE("scaled shape: a column of 10 scaled cubes in hull contact holds 10 ti
     }
     for (int i = 0; i < 180; ++i) REQUIRE(w->step(Scalar(1) / 60).ok());
     Scalar top = 0;
-    for (std::uint32_t i = 0; i < w->body_count(); ++i) top = w->body(i).position.z() > top ? w->body(i).position.z() : top;
+    for (std::uint32_t i = 0; i < w->body_count(); ++i)
+      top = w->body(i).position.z() > top ? w->body(i).position.z() : top;
     CHECK(std::fabs(top / (Scalar(1.9) * s) - 1) < Scalar(0.02));
   }
 }
