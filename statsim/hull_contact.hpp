@@ -158,11 +158,12 @@ HullCandidate<D> hull_candidate(const Shape<D>& sa, const Body<D>& a, const Shap
   if (k <= ka) {
     const Scalar* f = sa.signature.contact.faces + (k - 1) * fv;
     const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
-    return {n, f[D] + shape_support(sb, to_body(b.orientation, Vec(-n))), f[D + 1]};
+    const Scalar offset = f[D] * sa.signature.contact.offset_scale;
+    return {n, offset + shape_support(sb, to_body(b.orientation, Vec(-n))), f[D + 1]};
   }
   const Scalar* g = sb.signature.contact.faces + (k - 1 - ka) * fv;
   const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
-  return {n, shape_support(sa, to_body(a.orientation, n)) + g[D], g[D + 1]};
+  return {n, shape_support(sa, to_body(a.orientation, n)) + g[D] * sb.signature.contact.offset_scale, g[D + 1]};
 }
 
 /// Packing ratio of a pair touching along the line of centres `e`: each shape's by angle
@@ -223,10 +224,11 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
   for (std::uint32_t i = 0; i < ka; ++i) {
     const Scalar* f = sa.signature.contact.faces + i * fv;
     const Scalar c = Vec(Eigen::Map<const Vec>(f)).dot(ea);
+    const Scalar offset = f[D] * sa.signature.contact.offset_scale;
     const Scalar pf = packed ? f[D + 1] : Scalar(1);
-    if (!(c > 0) || !(pf * (f[D] + floor_b) < best * c)) continue;
+    if (!(c > 0) || !(pf * (offset + floor_b) < best * c)) continue;
     const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
-    const Scalar along = pf * ((f[D] + shape_support(sb, to_body(b.orientation, Vec(-n)))) / c);
+    const Scalar along = pf * ((offset + shape_support(sb, to_body(b.orientation, Vec(-n)))) / c);
     if (!(along > best)) {
       best = along;
       witness = 1 + i;
@@ -235,10 +237,11 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
   for (std::uint32_t i = 0; i < kb; ++i) {
     const Scalar* g = sb.signature.contact.faces + i * fv;
     const Scalar c = -Vec(Eigen::Map<const Vec>(g)).dot(eb);
+    const Scalar offset = g[D] * sb.signature.contact.offset_scale;
     const Scalar pg = packed ? g[D + 1] : Scalar(1);
-    if (!(c > 0) || !(pg * (g[D] + floor_a) < best * c)) continue;
+    if (!(c > 0) || !(pg * (offset + floor_a) < best * c)) continue;
     const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
-    const Scalar along = pg * ((shape_support(sa, to_body(a.orientation, n)) + g[D]) / c);
+    const Scalar along = pg * ((shape_support(sa, to_body(a.orientation, n)) + offset) / c);
     if (!(along > best)) {
       best = along;
       witness = 1 + ka + i;

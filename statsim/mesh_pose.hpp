@@ -35,12 +35,30 @@ const Scalar* mesh_frame_of(const View& view)
     return nullptr;
   }
 }
+
+template <class View, class = void>
+struct view_has_scale : std::false_type {};
+template <class View>
+struct view_has_scale<View, std::void_t<decltype(std::declval<const View&>().scale)>> : std::true_type {};
+
+/// The shape's size over the table's (`SignatureView::scale`), 1 for views without it.
+template <class View>
+Scalar scale_of(const View& view)
+{
+  if constexpr (view_has_scale<View>::value) {
+    return view.scale;
+  } else {
+    (void)view;
+    return 1;
+  }
+}
 }  // namespace detail
 
 /// The affine map from mesh coordinates (m) to world coordinates (m) of a 3D body at `position`
 /// (its centre of mass, m) and `orientation` (body to world, unit), for the shape whose table is
 /// `view` (a `SignatureView<3>`): apply it to the mesh's vertices, or hand it to a renderer as
-/// the model matrix. Setting-up and drawing code: not used by a step.
+/// the model matrix; a shape of another size (`scaled_view`) scales the mesh about c. Setting-up
+/// and drawing code: not used by a step.
 template <class View>
 Eigen::Transform<Scalar, 3, Eigen::Affine> mesh_to_world(const View& view, const Vector3& position,
                                                        const Quaternion& orientation)
@@ -53,6 +71,8 @@ Eigen::Transform<Scalar, 3, Eigen::Affine> mesh_to_world(const View& view, const
       for (int j = 0; j < 3; ++j) r(i, j) = f[3 * i + j];
     c = Vector3(f[9], f[10], f[11]);
   }
+  const Scalar s = detail::scale_of(view);
+  if (s != 1) r *= s;  // a body point s R (m - c)
   Eigen::Transform<Scalar, 3, Eigen::Affine> t;
   t.linear() = q * r;
   t.translation() = position - t.linear() * c;
@@ -73,6 +93,8 @@ Eigen::Transform<Scalar, 2, Eigen::Affine> mesh_to_world(const View& view, const
     r << f[0], f[1], f[2], f[3];
     c = Vector2(f[4], f[5]);
   }
+  const Scalar s = detail::scale_of(view);
+  if (s != 1) r *= s;
   Eigen::Transform<Scalar, 2, Eigen::Affine> t;
   t.linear() = q * r;
   t.translation() = position - t.linear() * c;

@@ -197,7 +197,7 @@ struct ResponseTableView {
 template <int D>
 struct RestPosesView {
   const Scalar* normals = nullptr;      ///< D numbers per pose, unit, body frame
-  const Scalar* heights = nullptr;      ///< m, centre of mass above the plane at rest
+  ValuesView heights;                   ///< m, centre of mass above the plane at rest
   const Scalar* frequencies = nullptr;  ///< fraction of reference drops that ended in the pose
   std::uint32_t count = 0;
   typename Space<D>::Vec normal(std::uint32_t i) const
@@ -237,6 +237,10 @@ struct SignatureView {
   /// does not record it (body frame = mesh frame).
   const Scalar* mesh_frame = nullptr;
   ContactView<D> contact;  ///< body-body data; absent (`present()` false) in older tables
+  /// Size of the shape over the size the table was gathered at (`scaled_view`); 1 for the
+  /// table's own view. Every length above already includes it; a mesh point m of the table's
+  /// mesh is the body point scale R (m - c).
+  Scalar scale = 1;
 };
 
 namespace detail {
@@ -323,7 +327,7 @@ constexpr SignatureView<D> signature_view(const S& s)
   v.response.mean = detail::values_view(s.response_mean);
   v.response.spread = detail::values_view(s.response_spread);
   v.rest.normals = s.rest_normals.data();
-  v.rest.heights = s.rest_heights.data();
+  v.rest.heights = detail::values_view(s.rest_heights);
   v.rest.frequencies = s.rest_frequencies.data();
   v.rest.count = static_cast<std::uint32_t>(s.rest_heights.size());
   if constexpr (detail::has_mesh_frame<S>::value) {
@@ -333,8 +337,8 @@ constexpr SignatureView<D> signature_view(const S& s)
     const auto& c = s.contact;
     v.contact.support_size = c.support_size;
     v.contact.support = detail::values_view(c.support);
-    v.contact.pair_mean = c.pair_mean.size() > 0 ? c.pair_mean.data() : nullptr;
-    v.contact.pair_stddev = c.pair_stddev.size() > 0 ? c.pair_stddev.data() : nullptr;
+    v.contact.pair_mean = c.pair_mean.size() > 0 ? detail::values_view(c.pair_mean) : ValuesView{};
+    v.contact.pair_stddev = c.pair_stddev.size() > 0 ? detail::values_view(c.pair_stddev) : ValuesView{};
     v.contact.faces = c.faces.size() > 0 ? c.faces.data() : nullptr;
     v.contact.face_count = static_cast<std::uint32_t>(c.faces.size() / face_values(D));
     for (std::size_t k = 0; k < 3; ++k) {

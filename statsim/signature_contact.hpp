@@ -12,13 +12,29 @@
 
 namespace statsim {
 
-/// Numbers of a table: stored as floats, or as 16-bit integers with value = offset + scale * q.
+/// Numbers of a table: stored as floats, value = scale * f32[i], or as 16-bit integers, value =
+/// offset + scale * q[i]. A table's own view of floats has scale 1 (x * 1 is x, bit for bit); a
+/// shape of another size (`scaled_view`) multiplies scale, and offset, by its size factor.
+/// Converts from a plain array (`const Scalar*`, scale 1) and compares equal to nullptr when it
+/// holds no values, so code that reads a table through a pointer reads it through a view alike.
 struct ValuesView {
   const Scalar* f32 = nullptr;
   const std::int16_t* i16 = nullptr;
   Scalar scale = 1;
   Scalar offset = 0;
-  Scalar operator[](std::uint32_t i) const { return f32 ? f32[i] : offset + scale * Scalar(i16[i]); }
+  constexpr ValuesView() = default;
+  constexpr ValuesView(const Scalar* f, const std::int16_t* q = nullptr, Scalar s = 1, Scalar o = 0)
+      : f32(f), i16(q), scale(s), offset(o)
+  {
+  }
+  /// Value i (any integer index, as a pointer takes).
+  template <class Index>
+  Scalar operator[](Index i) const
+  {
+    return f32 ? f32[i] * scale : offset + scale * Scalar(i16[i]);
+  }
+  friend constexpr bool operator==(const ValuesView& v, std::nullptr_t) { return !v.f32 && !v.i16; }
+  friend constexpr bool operator!=(const ValuesView& v, std::nullptr_t) { return v.f32 || v.i16; }
 };
 
 /// A sampled axis: `size` strictly increasing values.
@@ -67,10 +83,16 @@ template <int D>
 struct ContactView {
   std::uint32_t support_size = 0;  ///< S, >= 2; 0: no body-body data
   ValuesView support;              ///< m, 6 S^2 values (2D: 4 S)
-  const Scalar* pair_mean = nullptr;    ///< m, one per h_coll axis sample
-  const Scalar* pair_stddev = nullptr;  ///< m
-  const Scalar* faces = nullptr;  ///< `face_values(D)` numbers per face: unit normal, offset (m), packing ratio
+  ValuesView pair_mean;    ///< m, one per h_coll axis sample
+  ValuesView pair_stddev;  ///< m
+  /// `face_values(D)` numbers per face: unit normal, offset (m, times `offset_scale`), packing ratio
+  const Scalar* faces = nullptr;
   std::uint32_t face_count = 0;
+  /// Factor on the stored face offsets: 1 for the table's own size, its size factor for a
+  /// shape of another size (`scaled_view`).
+  Scalar offset_scale = 1;
+  /// Offset of face i, m.
+  Scalar face_offset(std::uint32_t i) const { return faces[i * face_values(D) + D] * offset_scale; }
   std::array<Scalar, 3> packing_mean{};    ///< ratio, by angle of the line of centres
   std::array<Scalar, 3> packing_stddev{};  ///< ratio
   bool present() const { return support_size >= 2; }

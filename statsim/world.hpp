@@ -28,6 +28,8 @@
 #include "statsim/events.hpp"
 #include "statsim/find_pairs.hpp"
 #include "statsim/rest_and_sleep.hpp"
+#include "statsim/shape_setup.hpp"
+#include "statsim/signature_scale.hpp"
 #include "statsim/world_checks.hpp"
 #include "statsim/world_data.hpp"
 #include "statsim/world_def.hpp"
@@ -100,40 +102,20 @@ class WorldCore {
     const Status s = detail::check_signature(sig);
     if (s != Status::ok) return {s, ShapeId{}};
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, ShapeId{}};
-    // The broad phase must hold every radius a body can take: the largest h_coll and h_rest.
-    Scalar largest = sig.bounding_radius, rest_max = 0;
-    for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i)
-      largest = sig.height.mean[i] > largest ? sig.height.mean[i] : largest;
-    for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
-      largest = sig.rest.heights[i] > largest ? sig.rest.heights[i] : largest;
-      rest_max = sig.rest.heights[i] > rest_max ? sig.rest.heights[i] : rest_max;
-    }
-    // The radius of a body at rest on other bodies: the rest heights weighted by how often the
-    // reference came to rest in each pose; without frequencies, the largest rest height (h_coll
-    // at spin 0 without rest poses).
-    Scalar weighted = 0, weight = 0;
-    for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
-      weighted += sig.rest.frequencies[i] * sig.rest.heights[i];
-      weight += sig.rest.frequencies[i];
-    }
-    const Scalar mean_rest = weight > 0 ? weighted / weight : (rest_max > 0 ? rest_max : sig.height.mean[0]);
-    // With body-body data a body also touches others as far out as its support map reaches,
-    // times the largest packing ratio.
-    Scalar floor = 0, packing = 1;
     Shape<D>& shape = w_.shapes[w_.shape_count];
-    shape = Shape<D>{0,         largest, sig.material, true, sig, {}, mean_rest, detail::signature_hash(sig),
-                     floor,     packing, sig.mass};
-    if (sig.contact.present()) {
-      const detail::SupportBounds sb = detail::support_bounds(sig.contact);
-      packing = detail::largest_packing(shape);
-      const Scalar reach = sb.ceiling * (packing > 1 ? packing : Scalar(1));
-      shape.bounding_radius = reach > largest ? reach : largest;
-      shape.support_floor = sb.floor;
-      shape.largest_packing = packing;
-    }
+    detail::statistical_shape(sig, shape);
     rest_basin_biases<D>(sig, shape.rest_bias.data());
     detail::note_bound(w_, shape.bounding_radius);
     return {Status::ok, ShapeId(std::uint16_t(w_.shape_count++), tag_)};
+  }
+
+  /// A statistical shape `scale` times its table's size (`scaled_view`; 1: `add_shape(sig)` bit for bit).
+  /// Rejected with `non_finite`, `out_of_range` (outside [`min_shape_scale`, `max_shape_scale`]), or as above.
+  Added<ShapeId> add_shape(const SignatureView<D>& sig, Scalar scale)
+  {
+    if (!std::isfinite(scale)) return {Status::non_finite, ShapeId{}};
+    if (!(scale >= min_shape_scale && scale <= max_shape_scale)) return {Status::out_of_range, ShapeId{}};
+    return add_shape(scaled_view(sig, scale));
   }
 
   /// Adds a static plane with the given normal (any length > 0; it is normalised) through the

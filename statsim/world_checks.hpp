@@ -167,7 +167,8 @@ Status check_signature_values(const SignatureView<D>& sig)
   // radii of the centre; face normals unit; packing ratios in (0, 2].
   const ContactView<D>& c = sig.contact;
   if (!c.present()) return Status::ok;
-  if (bad(c.support.scale) || bad(c.support.offset)) return Status::invalid_shape;
+  if (bad(c.support.scale) || bad(c.support.offset) || !(c.offset_scale > 0) || bad(c.offset_scale))
+    return Status::invalid_shape;
   const Scalar reach = 2 * sig.bounding_radius;
   for (std::uint32_t i = 0; i < c.support_count(); ++i)
     if (bad(c.support[i]) || !(std::fabs(c.support[i]) <= reach)) return Status::invalid_shape;
@@ -179,7 +180,8 @@ Status check_signature_values(const SignatureView<D>& sig)
     const Scalar* f = c.faces + k * face_values(D);
     Scalar n2 = 0;
     for (int d = 0; d < D; ++d) n2 += f[d] * f[d];
-    if (!(std::fabs(n2 - 1) < Scalar(2e-3)) || !(std::fabs(f[D]) <= sig.bounding_radius)) return Status::invalid_shape;
+    if (!(std::fabs(n2 - 1) < Scalar(2e-3)) || !(std::fabs(c.face_offset(k)) <= sig.bounding_radius))
+      return Status::invalid_shape;
     if (!(f[D + 1] > 0 && f[D + 1] <= 2)) return Status::invalid_shape;
   }
   for (std::size_t k = 0; k < 3; ++k)

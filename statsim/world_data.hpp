@@ -244,6 +244,7 @@ std::uint64_t signature_hash(const SignatureView<D>& sig)
   h.add_all(c.support_size, c.face_count);
   hash_values(h, c.support, c.support_count());
   for (std::uint32_t i = 0; i < c.face_count * face_values(D); ++i) h.add(c.faces[i]);
+  if (c.offset_scale != 1) h.add(c.offset_scale);  // a shape of another size (a table's own hashes as before)
   for (std::size_t k = 0; k < 3; ++k) h.add_all(c.packing_mean[k], c.packing_stddev[k]);
   if (c.pair_mean != nullptr)
     for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i) h.add_all(c.pair_mean[i], c.pair_stddev[i]);

@@ -3,6 +3,7 @@
 
 #include "common/atomic_file.hpp"
 #include "ref3d/cell_report.hpp"
+#include "ref3d/compare.hpp"
 #include "ref3d/gather.hpp"
 #include "ref3d/pairs.hpp"
 #include "ref3d/signature_json.hpp"
@@ -517,6 +518,7 @@ void register_ref3d_commands(CLI::App& app)
 {
   add_gather(app, &std::cout, &std::cerr);
   add_gather_pairs(app);
+  add_compare_command(app);
 }
 
 int run_gather_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err)
