@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job: runs the demo programs on the committed tables, from a built tree (the
-# paper's scenes: Figures 1, 5, 6 and 7, and the 2D drop).
+# paper's scenes: Figures 1, 5, 6 and 7, and the 2D drop; spawning, kicking and removing bodies).
 #   tools/main-job.sh [BUILD_DIR]   (default: build)
 set -euo pipefail
 bin="${1:-build}/bin"
@@ -19,4 +19,5 @@ run drop2d --png "$out/drop2d.png"
 run drop_boxes
 run drop_lshapes
 run rest_conditions
+run spawn_and_kick
 run bunnies 10000
