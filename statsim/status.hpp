@@ -27,6 +27,14 @@ enum class [[nodiscard]] Status : std::uint8_t {
   /// excess precision), so results are valid but not bit-identical to other builds. Compile
   /// with `-ffp-contract=off` (the CMake targets add it).
   float_contraction,
+  /// Only from `load`: the bytes are not a snapshot (magic), or are truncated, too long or
+  /// damaged (size field, checksum), or hold a value no world can have (see statsim/snapshot.hpp).
+  invalid_snapshot,
+  /// Only from `load`: a snapshot of another format version, dimension or `Scalar` width, or of
+  /// a world with the other broad-phase storage (`World`'s `Phases`).
+  snapshot_incompatible,
+  /// Only from `load`: the world's shapes differ from the snapshot's (count, order or data).
+  shape_mismatch,
 };
 
 /// Short, stable name of a status, for messages ("capacity_exceeded").
@@ -48,6 +56,9 @@ constexpr const char* to_string(Status s)
     case Status::invalid_parameter: return "invalid_parameter";
     case Status::out_of_range: return "out_of_range";
     case Status::float_contraction: return "float_contraction";
+    case Status::invalid_snapshot: return "invalid_snapshot";
+    case Status::snapshot_incompatible: return "snapshot_incompatible";
+    case Status::shape_mismatch: return "shape_mismatch";
   }
   return "unknown";
 }

@@ -40,6 +40,9 @@
 #include <cstdint>
 
 namespace statsim {
+namespace detail {
+struct SnapshotAccess;  // statsim/snapshot.hpp: `load` writes a world's arrays
+}  // namespace detail
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
 template <int D>
@@ -358,6 +361,7 @@ class WorldCore {
   ~WorldCore() = default;
 
  private:
+  friend struct detail::SnapshotAccess;
   detail::WorldData<D> w_;
   detail::ImpactLog<D> impacts_;
   Status construction_status_ = Status::ok;

@@ -1,0 +1,301 @@
+// World snapshots (statsim/snapshot.hpp): a world loaded from a snapshot steps on bit for bit as
+// the saved one; save, load, save gives the same bytes; a snapshot that is truncated, damaged,
+// of another version, dimension or scalar width, too large or of other shapes, or that holds a
+// value no world can have, is refused and the world is left as it was.
+#include <doctest/doctest.h>
+
+#include "support/snapshot_scene.hpp"
+
+#include "statsim/snapshot.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <vector>
+
+using namespace statsim;
+using statsim::testing::add_snapshot_shapes;
+using statsim::testing::build_snapshot_scene;
+
+namespace {
+using Bytes = std::vector<unsigned char>;
+constexpr Scalar dt = Scalar(1) / 60;
+using World3s = World3<128, 8, 768, 4, 16>;
+using World3l = World3<200, 8, 1200, 4, 16>;  // room for more: a smaller snapshot loads into it
+using World2s = World2<128, 8, 512, 4, 16>;
+
+template <int D>
+Bytes save_bytes(const WorldCore<D>& w)
+{
+  Bytes b(snapshot_size(w));
+  std::size_t n = 0;
+  REQUIRE(save(w, b.data(), b.size(), &n) == Status::ok);
+  REQUIRE(n == b.size());
+  return b;
+}
+
+/// Rewrites the checksum after an edit, so that the edit itself is what `load` meets.
+void reseal(Bytes& b)
+{
+  const std::uint64_t h = detail::fnv1a64(b.data(), b.size() - 8);
+  for (int i = 0; i < 8; ++i) b[b.size() - 8 + std::size_t(i)] = static_cast<unsigned char>(h >> (8 * i));
+}
+void put32(Bytes& b, std::size_t at, std::uint32_t x)
+{
+  for (int i = 0; i < 4; ++i) b[at + std::size_t(i)] = static_cast<unsigned char>(x >> (8 * i));
+}
+std::uint32_t get32(const Bytes& b, std::size_t at)
+{
+  std::uint32_t x = 0;
+  for (int i = 0; i < 4; ++i) x |= std::uint32_t(b[at + std::size_t(i)]) << (8 * i);
+  return x;
+}
+/// Offsets in a snapshot of the layout documented in statsim/snapshot.hpp.
+constexpr std::size_t def_offset = 32 + 28;
+template <int D>
+constexpr std::size_t sweep_axis_offset()
+{
+  return def_offset + 4 * D + 8 + 15 * 4 + 8;
+}
+template <int D>
+std::size_t first_body(std::uint32_t shapes, std::uint32_t planes)
+{
+  return def_offset + 4 * D + 8 + 15 * 4 + 16 + 8 + 8 * shapes + planes * (D + 1) * 4;
+}
+
+/// Saves `a`, loads the bytes into `b` (which has the scene's shapes), and steps both `steps`
+/// times: the state hashes agree after the load and after every step.
+template <int D, class A, class B>
+void check_continuation(A& a, B& b, int steps)
+{
+  const Bytes bytes = save_bytes<D>(a);
+  REQUIRE(load<D>(b, bytes.data(), bytes.size()) == Status::ok);
+  CHECK(b.state_hash() == a.state_hash());
+  CHECK(save_bytes<D>(b) == bytes);  // the round trip gives the same bytes
+  int differ = 0;
+  for (int s = 0; s < steps; ++s) {
+    REQUIRE(a.step(dt).status == Status::ok);
+    REQUIRE(b.step(dt).status == Status::ok);
+    differ += a.state_hash() != b.state_hash();
+  }
+  CHECK(differ == 0);
+}
+
+template <int D, class World>
+void check_scene(const WorldDef<D>& def, int save_at, bool mixed = true)
+{
+  auto a = std::make_unique<World>(def);
+  REQUIRE(build_snapshot_scene<D>(*a, 96, save_at));
+  // What the snapshot must carry: bodies in every state, contacts, removed and reused slots.
+  CHECK(a->count(MotionState::asleep) + a->count(MotionState::settling) > 0);
+  CHECK(a->live_body_count() < a->body_count());
+  std::uint32_t touching = 0;
+  for (std::uint32_t i = 0; i < a->body_count(); ++i) touching += a->data().bodies[i].touching;
+  if (mixed) {
+    CHECK(a->count(MotionState::moving) + a->count(MotionState::settling) > 0);
+    CHECK(touching > 0);
+  }
+  auto b = std::make_unique<World>();
+  REQUIRE(add_snapshot_shapes<D>(*b));
+  check_continuation<D>(*a, *b, 240);
+  // Again later in the pile, into a world of larger capacities.
+  auto c = std::make_unique<World3l>();
+  if constexpr (D == 3) {
+    REQUIRE(add_snapshot_shapes<D>(*c));
+    check_continuation<D>(*a, *c, 120);
+  }
+}
+}  // namespace
+
+TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (collision spheres, sweep-and-prune)")
+{
+  WorldDef3 def;
+  def.impact_threshold = Scalar(0.5);
+  for (int at : {40, 150, 300}) check_scene<3, World3s>(def, at);
+}
+
+TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (hull contacts, pile rest, grid)")
+{
+  WorldDef3 def;
+  def.body_contacts = BodyContacts::hulls;
+  def.pile_rest = true;
+  def.broad_phase = BroadPhase::grid;
+  def.seed = 77;
+  for (int at : {150, 300}) check_scene<3, World3s>(def, at);
+  def.broad_phase = BroadPhase::sweep_and_prune;
+  def.sweep_axis = 1;
+  check_scene<3, World3s>(def, 200);
+}
+
+TEST_CASE("snapshot: a loaded 2D pile steps on bit for bit")
+{
+  WorldDef2 def;
+  for (int at : {60, 200}) check_scene<2, World2s>(def, at);
+  def.body_contacts = BodyContacts::hulls;
+  def.broad_phase = BroadPhase::grid;
+  check_scene<2, World2s>(def, 120);
+  check_scene<2, World2s>(def, 250, false);  // all asleep
+}
+
+TEST_CASE("snapshot: size per body")
+{
+  // One body slot: 15 bytes of integers, 17 scalars (3D) or 11 (2D), a 4-byte sweep entry.
+  auto a = std::make_unique<World3s>();
+  REQUIRE(add_snapshot_shapes<3>(*a));
+  const std::size_t empty = snapshot_size(*a);
+  REQUIRE(a->add_body(BodyDef3{}).ok());
+  REQUIRE(a->step(dt).ok());
+  const std::size_t per3 = snapshot_size(*a) - empty;
+  auto b = std::make_unique<World2s>();
+  REQUIRE(add_snapshot_shapes<2>(*b));
+  const std::size_t empty2 = snapshot_size(*b);
+  REQUIRE(b->add_body(BodyDef2{}).ok());
+  REQUIRE(b->step(dt).ok());
+  const std::size_t per2 = snapshot_size(*b) - empty2;
+  std::printf("snapshot bytes per body: 3D %zu (Body<3> %zu), 2D %zu (Body<2> %zu); empty 3D world %zu\n", per3,
+              sizeof(Body<3>), per2, sizeof(Body<2>), empty);
+  CHECK(per3 == 15 + 17 * sizeof(Scalar) + 4);
+  CHECK(per2 == 15 + 11 * sizeof(Scalar) + 4);
+  CHECK(per3 <= sizeof(Body<3>));
+  CHECK(per2 <= sizeof(Body<2>));
+}
+
+TEST_CASE("snapshot: save into a buffer too small writes nothing past it")
+{
+  auto a = std::make_unique<World3s>();
+  REQUIRE(build_snapshot_scene<3>(*a, 40, 30));
+  const std::size_t need = snapshot_size(*a);
+  Bytes buf(need + 16, 0xab);
+  std::size_t n = 0;
+  CHECK(save(*a, buf.data(), need - 1, &n) == Status::capacity_exceeded);
+  CHECK(n == need);
+  for (unsigned char c : buf) REQUIRE(c == 0xab);
+  CHECK(save(*a, nullptr, 0, &n) == Status::capacity_exceeded);
+  CHECK(save(*a, buf.data(), buf.size(), &n) == Status::ok);
+  for (std::size_t i = need; i < buf.size(); ++i) REQUIRE(buf[i] == 0xab);
+}
+
+TEST_CASE("snapshot: refused loads leave the world as it was")
+{
+  auto a = std::make_unique<World3s>();
+  REQUIRE(build_snapshot_scene<3>(*a, 96, 150));
+  const Bytes good = save_bytes<3>(*a);
+  // The target: another pile, and its twin that no load is tried on.
+  WorldDef3 other;
+  other.seed = 5;
+  auto t = std::make_unique<World3s>(other);
+  auto twin = std::make_unique<World3s>(other);
+  REQUIRE(build_snapshot_scene<3>(*t, 60, 100));
+  REQUIRE(build_snapshot_scene<3>(*twin, 60, 100));
+  const std::uint64_t h0 = t->state_hash();
+  REQUIRE(h0 == twin->state_hash());
+  int accepted = 0, changed = 0;
+  const auto refused = [&](const Bytes& b, std::size_t n) {
+    const Status s = load(*t, b.data(), n);
+    accepted += s == Status::ok;
+    changed += t->state_hash() != h0;
+    return s;
+  };
+  SUBCASE("truncated, too long, every byte flipped")
+  {
+    for (std::size_t n = 0; n < good.size(); ++n) CHECK(refused(good, n) != Status::ok);
+    Bytes longer = good;
+    longer.push_back(0);
+    CHECK(refused(longer, longer.size()) == Status::invalid_snapshot);
+    for (std::size_t i = 0; i < good.size(); ++i) {
+      Bytes b = good;
+      b[i] ^= static_cast<unsigned char>(1u << (i % 8));
+      CHECK(refused(b, b.size()) != Status::ok);
+    }
+  }
+  SUBCASE("wrong version, dimension, scalar width, broad-phase storage")
+  {
+    Bytes b = good;
+    b[4] = 2;
+    reseal(b);
+    CHECK(refused(b, b.size()) == Status::snapshot_incompatible);
+    b = good;
+    b[7] = 8;  // a snapshot of a double build
+    reseal(b);
+    CHECK(refused(b, b.size()) == Status::snapshot_incompatible);
+    auto flat = std::make_unique<World2s>();
+    REQUIRE(add_snapshot_shapes<2>(*flat));
+    const std::uint64_t hf = flat->state_hash();
+    CHECK(load(*flat, good.data(), good.size()) == Status::snapshot_incompatible);
+    CHECK(flat->state_hash() == hf);
+    auto sweep_only = std::make_unique<World3<128, 8, 768, 4, 16, BroadPhase::sweep_and_prune>>();
+    REQUIRE(add_snapshot_shapes<3>(*sweep_only));
+    CHECK(load(*sweep_only, good.data(), good.size()) == Status::snapshot_incompatible);
+  }
+  SUBCASE("too large, other shapes")
+  {
+    auto small = std::make_unique<World3<32, 8, 192, 4>>();
+    REQUIRE(add_snapshot_shapes<3>(*small));
+    const std::uint64_t hs = small->state_hash();
+    CHECK(load(*small, good.data(), good.size()) == Status::capacity_exceeded);
+    CHECK(small->state_hash() == hs);
+    auto swapped = std::make_unique<World3s>();
+    ShapeDef ball;
+    ball.radius = 0.08f;
+    REQUIRE(swapped->add_shape(ball).ok());
+    REQUIRE(swapped->add_shape(statsim::tables::box.view()).ok());
+    CHECK(load(*swapped, good.data(), good.size()) == Status::shape_mismatch);
+    auto one = std::make_unique<World3s>();
+    REQUIRE(one->add_shape(statsim::tables::box.view()).ok());
+    CHECK(load(*one, good.data(), good.size()) == Status::shape_mismatch);
+    auto scaled = std::make_unique<World3s>();
+    REQUIRE(scaled->add_shape(statsim::tables::box.view(), Scalar(1.5)).ok());
+    REQUIRE(scaled->add_shape(ball).ok());
+    CHECK(load(*scaled, good.data(), good.size()) == Status::shape_mismatch);
+  }
+  SUBCASE("values no world can hold, under a valid checksum")
+  {
+    const std::size_t body = first_body<3>(2, 5);
+    const std::size_t position = body + 15 + 16;
+    const std::uint32_t entries = get32(good, 28);
+    const std::size_t order = good.size() - 8 - 4 * std::size_t(entries);
+    struct Edit {
+      std::size_t at;
+      std::uint32_t value;
+      Status expected;
+    };
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::uint32_t nan_bits, two_bits, far_bits;
+    const float two = 2, far = 2e6f;
+    std::memcpy(&nan_bits, &nan, 4);
+    std::memcpy(&two_bits, &two, 4);
+    std::memcpy(&far_bits, &far, 4);
+    const Edit edits[] = {
+        {position, nan_bits, Status::non_finite},
+        {position, far_bits, Status::out_of_range},
+        {body + 15, two_bits, Status::non_unit_quaternion},
+        {body + 3, 0x00ff0000u | get32(good, body + 3), Status::invalid_snapshot},  // motion state 255
+        {body + 3, (0xffff0000u & get32(good, body + 3)) | 9u, Status::invalid_shape},  // shape 9
+        {sweep_axis_offset<3>(), 5, Status::invalid_parameter},
+        {order, get32(good, order + 4), Status::invalid_snapshot},  // a slot twice in the sweep order
+        {order, entries, Status::invalid_snapshot},                 // a slot past the end
+        {20, 8, Status::ok},                                        // more planes than written
+        {def_offset - 4, 0x7f800000u, Status::invalid_snapshot},    // widest: no shape's diameter
+    };
+    for (const Edit& e : edits) {
+      Bytes b = good;
+      put32(b, e.at, e.value);
+      reseal(b);
+      CAPTURE(e.at);
+      const Status s = refused(b, b.size());
+      // (ok as expected: any refusal)
+      CHECK((e.expected == Status::ok ? s != Status::ok : s == e.expected));
+    }
+  }
+  CHECK(accepted == 0);
+  CHECK(changed == 0);
+  // Nothing a step reads changed either (the sweep order check writes only scratch).
+  int differ = 0;
+  for (int s = 0; s < 60; ++s) {
+    REQUIRE(t->step(dt).ok());
+    REQUIRE(twin->step(dt).ok());
+    differ += t->state_hash() != twin->state_hash();
+  }
+  CHECK(differ == 0);
+}
