@@ -8,7 +8,10 @@
 
 #include "scenes/synthetic_signatures.hpp"
 
+#include "support/snapshot_scene.hpp"
+
 #include "statsim/queries.hpp"
+#include "statsim/snapshot.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 
@@ -80,6 +83,9 @@ alignas(World3<N3>) unsigned char storage3[sizeof(World3<N3>)];
 alignas(World2<N2>) unsigned char storage2[sizeof(World2<N2>)];
 alignas(World3<N_big>) unsigned char storage_big[sizeof(World3<N_big>)];
 using EventWorld = World3<64, 8, 384, 8, 32>;
+using SnapWorld = World3<64, 8, 384, 4, 8>;
+alignas(SnapWorld) unsigned char storage_snap[2][sizeof(SnapWorld)];
+unsigned char snapshot_buffer[2][16384];
 alignas(EventWorld) unsigned char storage_events[sizeof(EventWorld)];
 
 template <int D, class W>
@@ -202,4 +208,27 @@ TEST_CASE("no heap allocation in impulses, sleep and wake, removal, impact event
   CHECK(impacts > 0);
   CHECK(hits > 0);
   std::destroy_at(w);
+}
+
+TEST_CASE("no heap allocation in saving and loading snapshots")
+{
+  g_allocations = 0;
+  Eigen::internal::set_is_malloc_allowed(false);
+  g_counting = true;
+  auto* a = new (storage_snap[0]) SnapWorld();
+  auto* b = new (storage_snap[1]) SnapWorld();
+  REQUIRE(statsim::testing::build_snapshot_scene<3>(*a, 60, 120));
+  REQUIRE(statsim::testing::add_snapshot_shapes<3>(*b));
+  std::size_t n = 0, m = 0;
+  REQUIRE(save(*a, snapshot_buffer[0], sizeof snapshot_buffer[0], &n) == Status::ok);
+  REQUIRE(load(*b, snapshot_buffer[0], n - 1) == Status::invalid_snapshot);
+  REQUIRE(load(*b, snapshot_buffer[0], n) == Status::ok);
+  for (int i = 0; i < 60; ++i) REQUIRE(b->step(1.0f / 60).status == Status::ok);
+  REQUIRE(save(*b, snapshot_buffer[1], sizeof snapshot_buffer[1], &m) == Status::ok);
+  g_counting = false;
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(g_allocations.load() == 0);
+  CHECK(b->step_count() == 180);
+  std::destroy_at(a);
+  std::destroy_at(b);
 }

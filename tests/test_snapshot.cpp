@@ -82,6 +82,8 @@ void check_continuation(A& a, B& b, int steps)
   CHECK(differ == 0);
 }
 
+int anchors = 0;  // bodies saved with their step start (`detail::keeps_step_start`)
+
 template <int D, class World>
 void check_scene(const WorldDef<D>& def, int save_at, bool mixed = true)
 {
@@ -91,7 +93,10 @@ void check_scene(const WorldDef<D>& def, int save_at, bool mixed = true)
   CHECK(a->count(MotionState::asleep) + a->count(MotionState::settling) > 0);
   CHECK(a->live_body_count() < a->body_count());
   std::uint32_t touching = 0;
-  for (std::uint32_t i = 0; i < a->body_count(); ++i) touching += a->data().bodies[i].touching;
+  for (std::uint32_t i = 0; i < a->body_count(); ++i) {
+    touching += a->data().bodies[i].touching;
+    anchors += detail::keeps_step_start(a->data(), a->data().bodies[i]);
+  }
   if (mixed) {
     CHECK(a->count(MotionState::moving) + a->count(MotionState::settling) > 0);
     CHECK(touching > 0);
@@ -122,7 +127,9 @@ TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (hull contacts, pile 
   def.pile_rest = true;
   def.broad_phase = BroadPhase::grid;
   def.seed = 77;
+  anchors = 0;
   for (int at : {150, 300}) check_scene<3, World3s>(def, at);
+  CHECK(anchors > 0);
   def.broad_phase = BroadPhase::sweep_and_prune;
   def.sweep_axis = 1;
   check_scene<3, World3s>(def, 200);
