@@ -1,0 +1,50 @@
+// Writes the seed corpus of fuzz_snapshot (tests/fuzz/corpus/fuzz_snapshot/): valid snapshots
+// of small piles in 2D and 3D, each after the input's first byte (fuzz_snapshot.cpp).
+//   build/bin/snapshot_seeds tests/fuzz/corpus/fuzz_snapshot
+#include "snapshot_worlds.hpp"
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+namespace {
+template <int D, class World>
+bool write_seed(const std::string& dir, const char* name, const statsim::WorldDef<D>& def, std::uint32_t bodies,
+                int steps)
+{
+  auto w = std::make_unique<World>();
+  if (!statsim::fuzz::build_seed_world<D>(*w, def, bodies, steps)) return false;
+  static unsigned char buf[16384];
+  buf[0] = D == 2 ? 1 : 0;
+  std::size_t n = 0;
+  if (statsim::save(*w, buf + 1, sizeof buf - 1, &n) != statsim::Status::ok) return false;
+  std::FILE* f = std::fopen((dir + "/" + name).c_str(), "wb");
+  if (f == nullptr) return false;
+  const bool ok = std::fwrite(buf, 1, n + 1, f) == n + 1;
+  return std::fclose(f) == 0 && ok;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  using namespace statsim;
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: snapshot_seeds DIR\n");
+    return 2;
+  }
+  const std::string dir = argv[1];
+  WorldDef3 d3;
+  WorldDef3 hulls;
+  hulls.body_contacts = BodyContacts::hulls;
+  hulls.broad_phase = BroadPhase::grid;
+  WorldDef2 d2;
+  WorldDef2 hulls2;
+  hulls2.body_contacts = BodyContacts::hulls;
+  const bool ok = write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d", d3, 30, 60) &&
+                  write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d_hulls_grid", hulls, 30, 150) &&
+                  write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d_small", d3, 5, 20) &&
+                  write_seed<2, fuzz::SnapWorld2>(dir, "seed_2d", d2, 30, 60) &&
+                  write_seed<2, fuzz::SnapWorld2>(dir, "seed_2d_hulls", hulls2, 30, 150);
+  if (!ok) std::fprintf(stderr, "snapshot_seeds: failed\n");
+  return ok ? 0 : 1;
+}
