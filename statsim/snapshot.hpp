@@ -367,6 +367,18 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
 
 }  // namespace detail
 
+/// The most bytes `save` writes for a world of these capacities (every slot holding a body
+/// measured from a sleep anchor): the size of a static buffer that holds any of its snapshots.
+template <int D>
+constexpr std::size_t snapshot_capacity(std::uint32_t max_bodies, std::uint32_t max_planes, std::uint32_t max_shapes)
+{
+  constexpr std::size_t s = sizeof(Scalar);
+  // Header, counters and widest; the `WorldDef` (gravity, seed, 15 scalars, 4 integers, 8 bytes);
+  // shapes, planes, body slots with their step start and sweep entry; the checksum.
+  return 32 + 24 + s + (D + 15) * s + 8 + 16 + 8 + 8 * std::size_t(max_shapes) + (D + 1) * s * max_planes +
+         (15 + (D == 3 ? 20 : 13) * s + 4) * std::size_t(max_bodies) + 8;
+}
+
 /// Bytes `save` writes for this world now: 32 + 8 per shape + (D + 1) scalars per plane, per
 /// body slot 15 bytes and 17 scalars in 3D (11 in 2D) plus a 4-byte sweep entry, a few hundred
 /// bytes of parameters, and D more scalars for each awake body measured from a sleep anchor.

@@ -70,6 +70,7 @@ template <int D, class A, class B>
 void check_continuation(A& a, B& b, int steps)
 {
   const Bytes bytes = save_bytes<D>(a);
+  CHECK(bytes.size() <= snapshot_capacity<D>(A::max_bodies, A::max_planes, A::max_shapes));
   REQUIRE(load<D>(b, bytes.data(), bytes.size()) == Status::ok);
   CHECK(b.state_hash() == a.state_hash());
   CHECK(save_bytes<D>(b) == bytes);  // the round trip gives the same bytes
@@ -164,6 +165,8 @@ TEST_CASE("snapshot: size per body")
               sizeof(Body<3>), per2, sizeof(Body<2>), empty);
   CHECK(per3 == 15 + 17 * sizeof(Scalar) + 4);
   CHECK(per2 == 15 + 11 * sizeof(Scalar) + 4);
+  CHECK(snapshot_capacity<3>(1, 0, 2) == empty + per3 + 12);  // the one body with an anchor
+  CHECK(snapshot_capacity<2>(1, 0, 2) == empty2 + per2 + 8);
   CHECK(per3 <= sizeof(Body<3>));
   CHECK(per2 <= sizeof(Body<2>));
 }

@@ -1,5 +1,7 @@
 # Runs the firmware under QEMU (mps2-an386, semihosting, -icount shift=0) and the host build of
-# the same source, and fails unless both succeed and print the same world lines.
+# the same source, and fails unless both succeed and print the same world lines. Then the host
+# build loads the snapshots the firmware printed (`firmware_host --snapshots FILE`), steps them
+# as the firmware did, and must print the firmware's hashes of their continuations.
 #   cmake -DQEMU=qemu-system-arm -DELF=firmware.elf -DHOST=firmware_host -P compare.cmake
 foreach(v QEMU ELF HOST)
   if(NOT DEFINED ${v})
@@ -25,6 +27,24 @@ endif()
 
 include(${CMAKE_CURRENT_LIST_DIR}/world_lines.cmake)
 expect_same_world_lines("${host_out}" "${fw_all}" 3 "the firmware")
+
+# Snapshots saved on the Cortex-M, continued on the host.
+set(snap_pattern "snap[23] continued [^\n]*hash 0x[0-9a-f]+")
+string(REGEX MATCHALL "${snap_pattern}" fw_snaps "${fw_all}")
+list(LENGTH fw_snaps n_snaps)
+if(NOT n_snaps EQUAL 2)
+  message(FATAL_ERROR "expected 2 snapshot lines from the firmware, got ${n_snaps}")
+endif()
+get_filename_component(fw_name ${ELF} NAME_WE)
+set(fw_file ${CMAKE_CURRENT_BINARY_DIR}/${fw_name}_output.txt)
+file(WRITE ${fw_file} "${fw_all}")
+execute_process(COMMAND ${HOST} --snapshots ${fw_file} RESULT_VARIABLE load_rc OUTPUT_VARIABLE load_out
+                ERROR_VARIABLE load_err TIMEOUT 120)
+message("host, continuing the firmware's snapshots (exit ${load_rc}):\n${load_out}${load_err}")
+string(REGEX MATCHALL "${snap_pattern}" host_snaps "${load_out}")
+if(NOT load_rc EQUAL 0 OR NOT host_snaps STREQUAL fw_snaps)
+  message(FATAL_ERROR "the host's continuation of the firmware's snapshots differs:\n  host: ${host_snaps}\n  firmware: ${fw_snaps}")
+endif()
 
 # Under -icount shift=0 a SysTick count (25 MHz) is 40 instructions.
 string(REGEX MATCHALL "firmware: (world[23]|models) systick [0-9]+ steps [0-9]+" clocks "${fw_all}")

@@ -12,6 +12,13 @@
 // integers, quantised at compile time by `statsim::quantize16`, the rule of `statsim gather --precision i16`).
 // FIRMWARE_TRACE (defined): also print the hash after every step. STATSIM_FIRMWARE is defined by
 // the Cortex-M build, STATSIM_WEB by the WebAssembly build.
+//
+// Snapshots (statsim/snapshot.hpp): the 3D and 2D worlds are saved while their bodies land
+// (saving reads the world only: the run and its hashes are the same), and after the run each is
+// loaded back from its snapshot and stepped `continued` steps; the snapshot is printed in hex
+// ("snap3 data ...") with the hash of its continuation ("snap3 continued ..."). The host build
+// given such output (`firmware_host --snapshots FILE`) loads those bytes into its own worlds,
+// steps as many steps and prints its hashes: compare.cmake checks that they are the firmware's.
 
 #include <statsim/config.hpp>
 #if defined(STATSIM_FIRMWARE) || defined(STATSIM_WEB)
@@ -19,6 +26,7 @@
 #define eigen_assert(x) STATSIM_ASSERT(x)
 #define EIGEN_NO_IO
 #endif
+#include <statsim/snapshot.hpp>
 #include <statsim/world2.hpp>
 #include <statsim/world3.hpp>
 #include <tables/square2d.hpp>
@@ -71,6 +79,7 @@ void write(const char* text) { statsim_web_write(text); }
 #else
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 namespace platform {
 void write(const char* text) { std::fputs(text, stdout); }
 [[noreturn]] void fail() { std::exit(1); }
@@ -172,6 +181,13 @@ statsim::World3<bodies, 8, pairs3, 2, 0, sweep_only> world3;
 statsim::World2<bodies, 8, pairs2, 2, 0, sweep_only> world2;
 statsim::World3<model_bodies, 1, 4 * model_bodies, 2, 0, sweep_only> world_models;
 
+// Snapshot buffers, sized for any snapshot of these worlds.
+constexpr int continued = 120;
+constexpr int snapshot_step = steps >= 90 ? 45 : steps / 2;  // 0.75 s: the first bodies are landing
+unsigned char snapshot3[statsim::snapshot_capacity<3>(bodies, 8, 2)];
+unsigned char snapshot2[statsim::snapshot_capacity<2>(bodies, 8, 2)];
+std::size_t snapshot3_size = 0, snapshot2_size = 0;
+
 /// A unit quaternion from four uniform draws (normalising a random 4-vector; no trigonometry).
 statsim::Quaternion random_orientation(statsim::Pcg32& rng)
 {
@@ -264,7 +280,8 @@ bool build_world_models()
 
 /// Steps a world and prints its line; returns false if a step failed or dropped pairs.
 template <class World>
-bool run(World& world, const char* label, const char* table)
+bool run(World& world, const char* label, const char* table, unsigned char* snapshot = nullptr,
+         std::size_t snapshot_cap = 0, std::size_t* snapshot_size = nullptr)
 {
   std::uint64_t dropped = 0;
   std::uint32_t peak_pairs = 0;
@@ -277,6 +294,8 @@ bool run(World& world, const char* label, const char* table)
     ok = ok && r.status == statsim::Status::ok;
     dropped += r.pairs_dropped;
     peak_pairs = r.pairs_found > peak_pairs ? r.pairs_found : peak_pairs;
+    if (snapshot != nullptr && i + 1 == snapshot_step)
+      ok = ok && statsim::save(world, snapshot, snapshot_cap, snapshot_size) == statsim::Status::ok;
 #ifdef FIRMWARE_TRACE
     // To find where two builds part: the hash after every step.
     Line().text(label).text(" step ").dec(std::uint64_t(i + 1)).text(" hash ").hex(world.state_hash()).emit();
@@ -310,20 +329,88 @@ bool run(World& world, const char* label, const char* table)
   return ok && dropped == 0;
 }
 
+/// Loads a snapshot into `world` (built with the same shapes), steps it `continued` times and
+/// prints its hash; with `print_data`, first the snapshot in hex, 64 bytes a line.
+template <class World>
+bool continue_snapshot(World& world, const char* label, const unsigned char* data, std::size_t size, bool print_data)
+{
+  for (std::size_t at = 0; print_data && at < size; at += 64) {
+    Line line;
+    line.text(label).text(" data ");
+    for (std::size_t k = at; k < size && k < at + 64; ++k) {
+      const char digits[3] = {"0123456789abcdef"[data[k] >> 4], "0123456789abcdef"[data[k] & 15u], '\0'};
+      line.text(digits);
+    }
+    line.emit();
+  }
+  const statsim::Status s = statsim::load(world, data, size);
+  if (s != statsim::Status::ok) {
+    Line().text(label).text(" load failed: ").text(statsim::to_string(s)).emit();
+    return false;
+  }
+  const std::uint64_t from = world.step_count();
+  const std::uint32_t asleep = world.count(statsim::MotionState::asleep);
+  bool ok = true;
+  for (int i = 0; i < continued; ++i) ok = ok && world.step(dt).ok();
+  Line().text(label).text(" continued from step ").dec(from).text(" asleep ").dec(asleep).text(" steps ").dec(std::uint64_t(continued)).text(" hash ").hex(world.state_hash()).emit();
+  return ok;
+}
+
+#if !defined(STATSIM_FIRMWARE) && !defined(STATSIM_WEB)
+/// The bytes of the lines "LABEL data HEX" of a firmware's output, into `out`; their count.
+std::size_t read_snapshot(const char* path, const char* label, unsigned char* out, std::size_t cap)
+{
+  std::FILE* f = std::fopen(path, "r");
+  if (f == nullptr) return 0;
+  char text[512];
+  char prefix[32] = {};
+  std::size_t n = 0, p = 0;
+  while (label[p] != '\0' && p + 7 < sizeof prefix) {
+    prefix[p] = label[p];
+    ++p;
+  }
+  for (const char* t = " data "; *t; ++t) prefix[p++] = *t;
+  const auto hex = [](char c) { return c <= '9' ? c - '0' : c - 'a' + 10; };
+  while (std::fgets(text, sizeof text, f) != nullptr) {
+    const char* at = std::strstr(text, prefix);
+    if (at == nullptr) continue;
+    for (at += p; at[0] && at[1] && at[0] != '\n' && n < cap; at += 2) out[n++] = static_cast<unsigned char>(hex(at[0]) * 16 + hex(at[1]));
+  }
+  std::fclose(f);
+  return n;
+}
+#endif
+
 }  // namespace
 
+#if !defined(STATSIM_FIRMWARE) && !defined(STATSIM_WEB)
+int main(int argc, char** argv)
+#else
 int main()
+#endif
 {
   statsim::set_assert_handler(&on_assert);
   if (!build_world3() || !build_world2() || !build_world_models()) {
     Line().text("firmware: could not build the worlds").emit();
     return 1;
   }
-  const bool ok3 = run(world3, "world3", table3.name);
-  const bool ok2 = run(world2, "world2", table2.name);
+#if !defined(STATSIM_FIRMWARE) && !defined(STATSIM_WEB)
+  // The host continues another build's snapshots: a file of its output.
+  if (argc == 3 && std::strcmp(argv[1], "--snapshots") == 0) {
+    snapshot3_size = read_snapshot(argv[2], "snap3", snapshot3, sizeof snapshot3);
+    snapshot2_size = read_snapshot(argv[2], "snap2", snapshot2, sizeof snapshot2);
+    const bool ok = continue_snapshot(world3, "snap3", snapshot3, snapshot3_size, false) &&
+                    continue_snapshot(world2, "snap2", snapshot2, snapshot2_size, false);
+    return ok ? 0 : 1;
+  }
+#endif
+  const bool ok3 = run(world3, "world3", table3.name, snapshot3, sizeof snapshot3, &snapshot3_size);
+  const bool ok2 = run(world2, "world2", table2.name, snapshot2, sizeof snapshot2, &snapshot2_size);
   const bool ok_models = run(world_models, "models", "cube_correlated_and_empirical");
+  const bool ok_snapshots = continue_snapshot(world3, "snap3", snapshot3, snapshot3_size, true) &&
+                            continue_snapshot(world2, "snap2", snapshot2, snapshot2_size, true);
 #ifdef STATSIM_FIRMWARE
   Line().text("firmware: stack used ").dec(platform::stack_used()).text(" of ").dec(platform::stack_size()).text(" bytes").emit();
 #endif
-  return ok3 && ok2 && ok_models ? 0 : 1;
+  return ok3 && ok2 && ok_models && ok_snapshots ? 0 : 1;
 }

@@ -1,7 +1,8 @@
 // libFuzzer target: `load` (statsim/snapshot.hpp) fed arbitrary bytes, in 2D and 3D.
 //
-// The first byte picks the dimension (bit 0: 2D) and how many steps follow an accepted load
-// (bits 1-2); the rest is the snapshot. The world loaded into holds a small pile of its own
+// The first byte picks the dimension (bit 0: 2D), how many steps follow an accepted load
+// (bits 1-2) and whether the snapshot's size field and checksum are rewritten to match the bytes
+// (bit 3), so that mutations reach the checks behind the checksum; the rest is the snapshot. The world loaded into holds a small pile of its own
 // (with the scene's shapes, so that a snapshot of the scene can load). Checked:
 //  - a refused load changes nothing: state_hash, counts, and the next steps (against a twin);
 //  - an accepted load saves back the same bytes (one encoding per state), and the world then
@@ -85,9 +86,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace statsim::fuzz;
   if (size < 1) return 0;
   const int steps = 1 + ((data[0] >> 1) & 3);
-  if (data[0] & 1)
-    run<2, SnapWorld2>(data + 1, size - 1, steps);
+  const std::uint8_t mode = data[0];
+  ++data;
+  --size;
+  static std::uint8_t sealed[16384];
+  if ((mode & 8) && size >= 40 && size <= sizeof sealed) {
+    for (std::size_t i = 0; i < size; ++i) sealed[i] = data[i];
+    for (int i = 0; i < 4; ++i) sealed[8 + i] = static_cast<std::uint8_t>(size >> (8 * i));
+    const std::uint64_t h = statsim::detail::fnv1a64(sealed, size - 8);
+    for (int i = 0; i < 8; ++i) sealed[size - 8 + std::size_t(i)] = static_cast<std::uint8_t>(h >> (8 * i));
+    data = sealed;
+  }
+  if (mode & 1)
+    run<2, SnapWorld2>(data, size, steps);
   else
-    run<3, SnapWorld3>(data + 1, size - 1, steps);
+    run<3, SnapWorld3>(data, size, steps);
   return 0;
 }

@@ -1,5 +1,6 @@
 // Writes the seed corpus of fuzz_snapshot (tests/fuzz/corpus/fuzz_snapshot/): valid snapshots
-// of small piles in 2D and 3D, each after the input's first byte (fuzz_snapshot.cpp).
+// of small piles in 2D and 3D, each after the input's first byte (fuzz_snapshot.cpp), which asks
+// for mutations to be resealed.
 //   build/bin/snapshot_seeds tests/fuzz/corpus/fuzz_snapshot
 #include "snapshot_worlds.hpp"
 
@@ -15,7 +16,7 @@ bool write_seed(const std::string& dir, const char* name, const statsim::WorldDe
   auto w = std::make_unique<World>();
   if (!statsim::fuzz::build_seed_world<D>(*w, def, bodies, steps)) return false;
   static unsigned char buf[16384];
-  buf[0] = D == 2 ? 1 : 0;
+  buf[0] = (D == 2 ? 1 : 0) | 8;  // 8: the fuzzer reseals mutations (fuzz_snapshot.cpp)
   std::size_t n = 0;
   if (statsim::save(*w, buf + 1, sizeof buf - 1, &n) != statsim::Status::ok) return false;
   std::FILE* f = std::fopen((dir + "/" + name).c_str(), "wb");
