@@ -8,6 +8,7 @@
 // 2D: polygon = Box2D 2.4.1 unit square (velocity 8, position 3 iterations, its default CCD);
 // statistical2d = statsim World2 with tables/square2d.hpp.
 #include "stress/stress.hpp"
+#include "stress/snapshot_cells.hpp"
 #include "common/commands.hpp"
 
 #include "bench/bench_internal.hpp"
@@ -450,6 +451,13 @@ public:
   void slopes();
   void small_time_step();
   void mass_ratio();
+  /// statsim only (snapshot_cells.cpp).
+  void snapshot()
+  {
+    snapshot_cells(want("statistical"), want("statistical2d"), opt_.hull_contacts,
+                   [this](const std::string& scene, const std::string& method, bool pass, const std::string& figure,
+                          const std::string& criterion) { add(scene, method, pass, figure, criterion); });
+  }
 
   std::unique_ptr<bench::Sim> sim3(const std::string& method, const Setup3& setup,
                                    const std::vector<scenes::BodyState3>& states, double dt) const
@@ -1346,11 +1354,12 @@ std::vector<StressCell> run_stress(const StressOptions& options)
       {"large-dt", &Matrix::large_time_step}, {"out-of-range", &Matrix::out_of_range},
       {"energy", &Matrix::energy}, {"deep-pile", &Matrix::deep_pile},
       {"long-run", &Matrix::long_run}, {"slopes", &Matrix::slopes},
-      {"small-dt", &Matrix::small_time_step}, {"mass-ratio", &Matrix::mass_ratio}};
+      {"small-dt", &Matrix::small_time_step}, {"mass-ratio", &Matrix::mass_ratio},
+      {"snapshot", &Matrix::snapshot}};
   for (const auto& name : options.scenes)
     if (std::none_of(scenes.begin(), scenes.end(), [&name](const auto& s) { return s.first == name; }))
       throw std::invalid_argument("unknown scene '" + name + "' (bad-input, fast-impact, large-dt, out-of-range, "
-                                  "energy, deep-pile, long-run, slopes, small-dt, mass-ratio)");
+                                  "energy, deep-pile, long-run, slopes, small-dt, mass-ratio, snapshot)");
   Matrix mx(options, bench::load_body3("bunny", dir), dir);
   for (const auto& s : scenes)
     if (options.scenes.empty() ||
@@ -1390,7 +1399,7 @@ void register_stress_commands(CLI::App& app)
       ->delimiter(',');
   cmd->add_option("--scenes", opts->scenes,
                   "Scenes (default all): bad-input, fast-impact, large-dt, out-of-range, energy, deep-pile, long-run, "
-                  "slopes, small-dt, mass-ratio")
+                  "slopes, small-dt, mass-ratio, snapshot")
       ->delimiter(',');
   cmd->add_option("--json", *json, "Write the cells as JSON to FILE");
   cmd->add_flag("--quick", opts->quick, "Smaller scenes: 1,000-bunny pile, 2,000 energy steps, 120 s long run, 36 bunnies per slope");
