@@ -10,6 +10,7 @@
 // Build-time choices (-D...): FIRMWARE_BODIES (bodies per world, 64), FIRMWARE_STEPS (2000),
 // FIRMWARE_SHAPE (0 box, 1 L-shape, 2 bunny), FIRMWARE_I16 (1: response tables as 16-bit
 // integers, quantised at compile time by `statsim::quantize16`, the rule of `statsim gather --precision i16`).
+// FIRMWARE_SNAPSHOT (1; 0 for the footprint variants): the snapshot round trip below.
 // FIRMWARE_TRACE (defined): also print the hash after every step. STATSIM_FIRMWARE is defined by
 // the Cortex-M build, STATSIM_WEB by the WebAssembly build.
 //
@@ -43,6 +44,9 @@
 #endif
 #ifndef FIRMWARE_I16
 #define FIRMWARE_I16 0
+#endif
+#ifndef FIRMWARE_SNAPSHOT
+#define FIRMWARE_SNAPSHOT 1
 #endif
 
 #if FIRMWARE_SHAPE == 0
@@ -181,12 +185,14 @@ statsim::World3<bodies, 8, pairs3, 2, 0, sweep_only> world3;
 statsim::World2<bodies, 8, pairs2, 2, 0, sweep_only> world2;
 statsim::World3<model_bodies, 1, 4 * model_bodies, 2, 0, sweep_only> world_models;
 
+#if FIRMWARE_SNAPSHOT
 // Snapshot buffers, sized for any snapshot of these worlds.
 constexpr int continued = 120;
 constexpr int snapshot_step = steps >= 90 ? 45 : steps / 2;  // 0.75 s: the first bodies are landing
 unsigned char snapshot3[statsim::snapshot_capacity<3>(bodies, 8, 2)];
 unsigned char snapshot2[statsim::snapshot_capacity<2>(bodies, 8, 2)];
 std::size_t snapshot3_size = 0, snapshot2_size = 0;
+#endif
 
 /// A unit quaternion from four uniform draws (normalising a random 4-vector; no trigonometry).
 statsim::Quaternion random_orientation(statsim::Pcg32& rng)
@@ -294,8 +300,14 @@ bool run(World& world, const char* label, const char* table, unsigned char* snap
     ok = ok && r.status == statsim::Status::ok;
     dropped += r.pairs_dropped;
     peak_pairs = r.pairs_found > peak_pairs ? r.pairs_found : peak_pairs;
+#if FIRMWARE_SNAPSHOT
     if (snapshot != nullptr && i + 1 == snapshot_step)
       ok = ok && statsim::save(world, snapshot, snapshot_cap, snapshot_size) == statsim::Status::ok;
+#else
+    (void)snapshot;
+    (void)snapshot_cap;
+    (void)snapshot_size;
+#endif
 #ifdef FIRMWARE_TRACE
     // To find where two builds part: the hash after every step.
     Line().text(label).text(" step ").dec(std::uint64_t(i + 1)).text(" hash ").hex(world.state_hash()).emit();
@@ -329,6 +341,7 @@ bool run(World& world, const char* label, const char* table, unsigned char* snap
   return ok && dropped == 0;
 }
 
+#if FIRMWARE_SNAPSHOT
 /// Loads a snapshot into `world` (built with the same shapes), steps it `continued` times and
 /// prints its hash; with `print_data`, first the snapshot in hex, 64 bytes a line.
 template <class World>
@@ -380,6 +393,7 @@ std::size_t read_snapshot(const char* path, const char* label, unsigned char* ou
   return n;
 }
 #endif
+#endif  // FIRMWARE_SNAPSHOT
 
 }  // namespace
 
@@ -394,7 +408,7 @@ int main()
     Line().text("firmware: could not build the worlds").emit();
     return 1;
   }
-#if !defined(STATSIM_FIRMWARE) && !defined(STATSIM_WEB)
+#if FIRMWARE_SNAPSHOT && !defined(STATSIM_FIRMWARE) && !defined(STATSIM_WEB)
   // The host continues another build's snapshots: a file of its output.
   if (argc == 3 && std::strcmp(argv[1], "--snapshots") == 0) {
     snapshot3_size = read_snapshot(argv[2], "snap3", snapshot3, sizeof snapshot3);
@@ -403,12 +417,22 @@ int main()
                     continue_snapshot(world2, "snap2", snapshot2, snapshot2_size, false);
     return ok ? 0 : 1;
   }
+#elif !defined(STATSIM_FIRMWARE) && !defined(STATSIM_WEB)
+  (void)argc;
+  (void)argv;
 #endif
+#if FIRMWARE_SNAPSHOT
   const bool ok3 = run(world3, "world3", table3.name, snapshot3, sizeof snapshot3, &snapshot3_size);
   const bool ok2 = run(world2, "world2", table2.name, snapshot2, sizeof snapshot2, &snapshot2_size);
   const bool ok_models = run(world_models, "models", "cube_correlated_and_empirical");
   const bool ok_snapshots = continue_snapshot(world3, "snap3", snapshot3, snapshot3_size, true) &&
                             continue_snapshot(world2, "snap2", snapshot2, snapshot2_size, true);
+#else
+  const bool ok3 = run(world3, "world3", table3.name);
+  const bool ok2 = run(world2, "world2", table2.name);
+  const bool ok_models = run(world_models, "models", "cube_correlated_and_empirical");
+  const bool ok_snapshots = true;
+#endif
 #ifdef STATSIM_FIRMWARE
   Line().text("firmware: stack used ").dec(platform::stack_used()).text(" of ").dec(platform::stack_size()).text(" bytes").emit();
 #endif
