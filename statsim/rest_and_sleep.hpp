@@ -5,6 +5,7 @@
 /// (moving, settling, asleep).
 
 #include "statsim/hull_contact.hpp"
+#include "statsim/tipping.hpp"
 #include "statsim/world_data.hpp"
 
 #include <cstdint>
@@ -99,6 +100,94 @@ void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground
   }
 }
 
+/// On a ground plane of unit normal `n` that gravity pulls bodies along (`downhill`, and
+/// `slope` = |g_t| / |g.n| = tan of the tilt a): whether rest pose `pose` of a body of shape
+/// `shape`, turned from `orientation` into the pose against the plane, fails to hold it. A rigid
+/// body stands on its support set, the face under it; the line of gravity through its centre
+/// meets the plane h tan(a) downhill of the point under the centre (h the support toward the
+/// plane), and the body tips over the face's downhill edge once that point is beyond the edge:
+/// e < h tan(a), e the face's extent downhill (`support_extent`). The tilt at which a pose stops
+/// holding, atan(e / h), thus depends on the direction the slope falls in the body's frame, and
+/// is read from the support map: no table holds it. The shape must have a support map.
+template <int D>
+bool pose_tips(const Shape<D>& shape, const typename Space<D>::Rot& orientation, std::uint32_t pose,
+               const typename Space<D>::Vec& n, const typename Space<D>::Vec& downhill, Scalar slope)
+{
+  using Vec = typename Space<D>::Vec;
+  const SignatureView<D>& sig = shape.signature;
+  const typename Space<D>::Rot at_rest = snap_to_rest(orientation, sig.rest.normal(pose), n);
+  const Vec down = to_body(at_rest, Vec(-n));
+  const Scalar h = support_along(sig.contact, down);
+  return h * slope > support_extent(shape, down, to_body(at_rest, downhill), h);
+}
+
+/// What `settle_on_slope` decided for a body settling on a tilted ground plane.
+enum class SlopeSettle {
+  pose,     ///< it settles as on level ground, in its pose or the nearest that holds it
+  tipping,  ///< it tips on: no pose, no sleep in this step
+  held,     ///< no pose holds it, but what it stands on does: no pose, it may sleep where it is
+};
+
+/// A statistical body settling on a tilted ground plane of unit normal `n`: a pose that does not
+/// hold it there (`pose_tips`) is no rest pose. Its pose (the chosen one, else the nearest) is
+/// kept where it holds. Else, where the line of gravity passes downhill of the support set the
+/// body stands on now, it tips over that set's downhill edge (`tip_over`) toward the next pose
+/// downhill and takes none; where that set holds it, it settles into the nearest pose that
+/// holds on this plane, or, with none, stays where it is (it may sleep there, as a body propped
+/// out of its poses). Level ground (no pull along it) never gets here: its bits are unchanged.
+template <int D>
+SlopeSettle settle_on_slope(const WorldData<D>& w, Body<D>& b, const typename Space<D>::Vec& n)
+{
+  using Vec = typename Space<D>::Vec;
+  const Shape<D>& shape = w.shapes[b.shape];
+  const SignatureView<D>& sig = shape.signature;
+  const WorldDef<D>& def = w.def;
+  if (!shape.statistical || !def.rest_conditions || sig.rest.count == 0 || !sig.contact.present())
+    return SlopeSettle::pose;
+  const Scalar gn = def.gravity.dot(n);
+  const Vec gt = def.gravity - n * gn;
+  const Scalar pull = gt.norm();
+  if (!(gn < 0) || !(pull > 0)) return SlopeSettle::pose;
+  const Vec downhill = gt / pull;
+  const Scalar slope = pull / -gn;
+  const Scalar* bias = shape.rest_bias.data();
+  const std::uint32_t pose =
+      b.rest_pose != no_rest_pose ? b.rest_pose : nearest_rest_pose<D>(sig, b.orientation, n, bias);
+  if (pose >= sig.rest.count || !pose_tips(shape, b.orientation, pose, n, downhill, slope)) return SlopeSettle::pose;
+  // The support set it stands on now: the line of gravity meets the plane h tan(a) downhill of
+  // the point under the centre; beyond the set's downhill extent e the body turns about the
+  // set's edge, e downhill of that point.
+  const Vec down = to_body(b.orientation, Vec(-n));
+  const Scalar h = support_along(sig.contact, down);
+  const Scalar e = support_extent(shape, down, to_body(b.orientation, downhill), h);
+  // A tip slower than the sleep speed (the body near balance over the edge: on a curved part of
+  // its hull it rolls until the line of gravity meets the point it stands on) counts as held.
+  const Scalar g = def.gravity.norm();
+  if (h * slope > e) {
+    const Scalar spin = tip_over(shape, b, Vec(b.position - n * h + downhill * e), Vec(def.gravity / g), g,
+                                 def.settle_speed);
+    if (spin * shape.bounding_radius >= def.sleep_speed) {
+      b.rest_pose = no_rest_pose;
+      b.rest_blend = 0;
+      return SlopeSettle::tipping;
+    }
+  }
+  // Held where it stands: the nearest pose among those that hold (the score of
+  // `nearest_rest_pose`); a new pose starts its radius blend afresh.
+  std::uint32_t best = no_rest_pose;
+  Scalar best_score = -std::numeric_limits<Scalar>::infinity();
+  for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
+    const Scalar score = (b.orientation * sig.rest.normal(i)).dot(n) + bias[i];
+    if (score > best_score && !pose_tips(shape, b.orientation, i, n, downhill, slope)) {
+      best_score = score;
+      best = i;
+    }
+  }
+  if (best != b.rest_pose) b.rest_blend = 0;
+  b.rest_pose = std::uint8_t(best);
+  return best == no_rest_pose ? SlopeSettle::held : SlopeSettle::pose;
+}
+
 /// True when the chosen rest pose's normal is within `rest_snap_cosine` of the ground's normal.
 template <int D>
 bool in_rest_pose(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& ground)
@@ -112,7 +201,7 @@ bool in_rest_pose(const WorldData<D>& w, const Body<D>& b, const typename Space<
 /// `settle_speed`) or, once still for `sleep_time`, asleep; settling bodies follow the resting
 /// conditions.
 template <int D>
-void update_motion_states(WorldData<D>& w, Scalar dt)
+void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
 {
   using Vec = typename Space<D>::Vec;
   const WorldDef<D>& def = w.def;
@@ -131,7 +220,12 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const Scalar speed2 = v2 > w2 ? v2 : w2;
     const bool settling = b.touching && speed2 < settle2;
     const Vec ground = settling && b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
-    update_rest_pose(w, b, settling && b.on_ground, settling && !b.on_ground, speed2 >= settle2, dt, ground);
+    // On a slope a pose steeper than its tipping angle is no rest pose (`settle_on_slope`).
+    const SlopeSettle slope = tilted_planes && settling && b.on_ground ? settle_on_slope(w, b, ground)
+                                                                         : SlopeSettle::pose;
+    const bool tipping = slope == SlopeSettle::tipping;
+    update_rest_pose(w, b, settling && b.on_ground && slope == SlopeSettle::pose, settling && !b.on_ground,
+                     speed2 >= settle2, dt, ground);
     if (!settling) {
       b.state = MotionState::moving;
       b.slow_time = 0;
@@ -156,11 +250,12 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     }
     // It turns at ground contacts: one that keeps its pose while held up by other bodies cannot
     // reach it there, and may sleep where it is.
-    const bool posed = !turning || !b.on_ground || in_rest_pose(w, b, ground);
+    // (On a slope `settle_on_slope` may have taken the pose away in this step.)
+    const bool posed = !turning || b.rest_pose == no_rest_pose || !b.on_ground || in_rest_pose(w, b, ground);
     // On its hull (`hull_radius`) a body propped by others may stay still out of its pose; it
     // sleeps where it is after three sleep times.
     const bool wedged = !posed && hull_radius(w, b, ground) > b.radius;
-    const bool still = (lin2 > w2 ? lin2 : w2) < sleep2 && (posed || wedged);
+    const bool still = !tipping && (lin2 > w2 ? lin2 : w2) < sleep2 && (posed || wedged);
     b.slow_time = still ? b.slow_time + dt : 0;
     if (still && b.slow_time >= (posed ? def.sleep_time : 3 * def.sleep_time)) {
       b.state = MotionState::asleep;

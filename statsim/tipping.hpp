@@ -154,43 +154,46 @@ bool supporting(const WorldData<D>& w, Body<D>& a, Body<D>& b, const typename Sp
 /// (rolling resistance at a resting contact) cannot hold it, and it never exceeds what falling
 /// from balance gives. As the rest turn on the ground, it is capped where the body's farthest
 /// point would move faster than `settle_speed`: contacts correct positions, not orientations, so
-/// a fast turn would swing the body into its neighbours.
+/// a fast turn would swing the body into its neighbours. Returns that spin, rad/s (0 where the
+/// centre has not fallen from balance, or with no axis to turn about).
 template <int D>
-void tip_over(const Shape<D>& shape, Body<D>& b, const typename Space<D>::Vec& pivot,
+Scalar tip_over(const Shape<D>& shape, Body<D>& b, const typename Space<D>::Vec& pivot,
               const typename Space<D>::Vec& gravity_unit, Scalar gravity, Scalar settle_speed)
 {
   using Vec = typename Space<D>::Vec;
   const Vec r = b.position - pivot;
   const Scalar r2 = r.squaredNorm();
   const Scalar drop = std::sqrt(r2) + r.dot(gravity_unit);
-  if (!(drop > 0)) return;
+  if (!(drop > 0)) return 0;
   const std::array<Scalar, 3>& inertia = shape.signature.unit_inertia;
   const Scalar cap = settle_speed / shape.bounding_radius;
   if constexpr (D == 3) {
     const Vector3 axis = r.cross(gravity_unit);
     const Scalar length = axis.norm();
-    if (!(length > 0)) return;
+    if (!(length > 0)) return 0;
     const Vector3 k = axis / length;
     const Vector3 kb = to_body(b.orientation, k);
     const Scalar k2 = inertia[0] * kb.x() * kb.x() + inertia[1] * kb.y() * kb.y() + inertia[2] * kb.z() * kb.z();
     const Scalar fall = std::sqrt(2 * gravity * drop / (k2 + r2));
     const Scalar spin = fall < cap ? fall : cap;
     const Scalar now = b.angular_velocity.dot(k);
-    if (!(now < spin)) return;
+    if (!(now < spin)) return spin;
     const Vector3 dw = k * (spin - now);
     b.angular_velocity += dw;
     b.linear_velocity += dw.cross(r);
+    return spin;
   } else {
     const Scalar turn = moment(r, gravity_unit);
-    if (turn == 0) return;
+    if (turn == 0) return 0;
     const Scalar sign = turn > 0 ? Scalar(1) : Scalar(-1);
     const Scalar fall = std::sqrt(2 * gravity * drop / (inertia[0] + r2));
     const Scalar spin = fall < cap ? fall : cap;
     const Scalar now = b.angular_velocity * sign;
-    if (!(now < spin)) return;
+    if (!(now < spin)) return spin;
     const Scalar dw = sign * (spin - now);
     b.angular_velocity += dw;
     b.linear_velocity += cross(dw, r);
+    return spin;
   }
 }
 

@@ -116,6 +116,82 @@ void slides_on_steep_slope(const SignatureView<D>& sig)
 }
 }  // namespace
 
+namespace {
+/// The tipping angle, degrees, of rest pose `pose` of a statistical shape on a plane of unit
+/// normal `normal` falling along `downhill`, the body in the pose turned about the normal by
+/// `yaw` (rad), written to `orientation`: atan(e / h) from the support map, h the support toward
+/// the plane and e the support set's extent downhill.
+float tipping_degrees(const Shape<3>& shape, std::uint32_t pose, const Vector3& normal, const Vector3& downhill,
+                      float yaw, Quaternion& orientation)
+{
+  const SignatureView<3>& sig = shape.signature;
+  orientation = Quaternion(Eigen::AngleAxisf(yaw, normal)) *
+                snap_to_rest(Quaternion::Identity(), sig.rest.normal(pose), normal);
+  const Vector3 down = detail::to_body(orientation, Vector3(-normal));
+  const float h = detail::support_along(sig.contact, down);
+  const float e = detail::support_extent(shape, down, detail::to_body(orientation, downhill), h);
+  return std::atan2(e, h) * 180 / kPi;
+}
+}  // namespace
+
+TEST_CASE("slopes - a bunny at rest in a pose steeper than its tipping angle tumbles on; within it, it sleeps there")
+{
+  // 20 degrees, below friction 0.5's 26.6: a held block would not slide. For each rest pose, the
+  // yaws at which the slope falls across the pose's support set where it is narrowest and where
+  // it is widest (from the support map); a pose narrow enough downhill is no rest pose there, a
+  // wide one is.
+  const float a = 20 * kPi / 180;
+  const Vector3 normal(0, std::sin(a), std::cos(a)), downhill(0, std::cos(a), -std::sin(a));
+  const SignatureView<3> sig = tables::bunny.view();
+  int tested = 0;
+  for (std::uint32_t pose = 0; pose < sig.rest.count; ++pose) {
+    CAPTURE(pose);
+    auto w = std::make_unique<World<3, 8>>();
+    const ShapeId id = w->add_shape(sig).id;
+    REQUIRE(w->add_plane(normal, 0).ok());
+    const Shape<3>& shape = w->shape(id);
+    float narrow = 90, wide = -90, narrow_yaw = 0, wide_yaw = 0;
+    Quaternion q;
+    for (int k = 0; k < 72; ++k) {
+      const float yaw = float(k) * 2 * kPi / 72, t = tipping_degrees(shape, pose, normal, downhill, yaw, q);
+      if (t < narrow) narrow = t, narrow_yaw = yaw;
+      if (t > wide) wide = t, wide_yaw = yaw;
+    }
+    Quaternion tips, holds;
+    tipping_degrees(shape, pose, normal, downhill, narrow_yaw, tips);
+    tipping_degrees(shape, pose, normal, downhill, wide_yaw, holds);
+    // Margins beyond the support map's resolution (one cell: 7 degrees at its 17 nodes), and
+    // poses that a body exactly in them takes (the basin biases may give it another one).
+    const auto takes = [&](const Quaternion& o) {
+      return nearest_rest_pose<3>(sig, o, normal, shape.rest_bias.data()) == pose;
+    };
+    if (!(narrow < 20 - 8 && wide > 20 + 8 && takes(tips) && takes(holds))) continue;
+    ++tested;
+    // At rest in the pose, at its height above the plane, 1 m apart across the slope.
+    for (int i = 0; i < 2; ++i) {
+      BodyDef<3> b;
+      b.shape = id;
+      b.mass = sig.mass;
+      b.orientation = i == 0 ? tips : holds;
+      b.position = Vector3(float(i), 0, 0) + normal * sig.rest.heights[pose];
+      REQUIRE(w->add_body(b).ok());
+    }
+    const Vector3 start0 = w->body(0).position, start1 = w->body(1).position;
+    for (int k = 0; k < 300; ++k) REQUIRE(w->step(kDt).ok());
+    const auto in_pose = [&](std::uint32_t i) {
+      return (w->body(i).orientation * sig.rest.normal(pose)).dot(normal) > std::cos(5 * kPi / 180);
+    };
+    // Held: asleep in its pose where it was put.
+    CHECK(w->body(1).state == MotionState::asleep);
+    CHECK(in_pose(1));
+    CHECK((w->body(1).position - start1).norm() < 0.01f);
+    // Not held: it has tipped out of the pose, downhill.
+    CHECK_FALSE(in_pose(0));
+    CHECK((w->body(0).position - start0).dot(downhill) > 0.01f);
+  }
+  CHECK(tested >= 2);
+}
+
 TEST_CASE("slopes - bunnies on 10 degrees with friction 0.5 fall asleep in a pose against the plane and stay put")
 {
   rests_on_gentle_slope<3>(tables::bunny.view());
