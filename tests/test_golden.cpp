@@ -52,6 +52,38 @@ std::uint64_t run_scene(World& w, const Sig& sig)
   for (int i = 0; i < 600; ++i) REQUIRE(w.step(1.0f / 60).status == Status::ok);
   return w.state_hash();
 }
+
+/// A heap of one shape on the hashed grid: a single bounding radius takes the grid search's
+/// branch-free loop, whose pairs (and their order, which the contact passes follow) must be the
+/// general loop's. The scenes above have two shapes and sweep-and-prune.
+template <int D, class World, class Sig>
+std::uint64_t run_grid_heap(World& w, const Sig& sig)
+{
+  const ShapeId stat = w.add_shape(sig.view()).id;
+  using Vec = typename Space<D>::Vec;
+  REQUIRE(w.add_plane(Vec::Unit(Space<D>::up_axis), 0).ok());
+  Pcg32 g(2026, 18);
+  const int side = D == 3 ? 8 : 30;
+  for (int i = 0; i < 600; ++i) {
+    BodyDef<D> b;
+    b.shape = stat;
+    b.mass = 1;
+    // A lattice of 0.4 m cells, side x side per layer, jittered, with random velocities.
+    int q = i;
+    for (int k = 0; k < D; ++k) {
+      const bool up = k == Space<D>::up_axis;
+      const int cell = up ? q : q % side;
+      if (!up) q /= side;
+      const float jitter = g.uniform(-0.03f, 0.03f);
+      b.position[k] = 0.4f * float(cell) + jitter + (up ? 0.3f : 0.0f);
+      const float v = g.uniform(-1, 1);
+      b.linear_velocity[k] = v;
+    }
+    REQUIRE(w.add_body(b).ok());
+  }
+  for (int i = 0; i < 300; ++i) REQUIRE(w.step(1.0f / 60).status == Status::ok);
+  return w.state_hash();
+}
 }  // namespace
 
 TEST_CASE("golden hash of a fixed 3D scene")
@@ -68,4 +100,20 @@ TEST_CASE("golden hash of a fixed 2D scene")
   const std::uint64_t h = run_scene<2>(*w, statsim::testing::square2d_synthetic);
   std::printf("golden 2D: 0x%016llx\n", static_cast<unsigned long long>(h));
   CHECK(h == 0x3106f6d15c635e4aull);
+}
+
+TEST_CASE("golden hashes of heaps of one shape on the grid (3D and 2D)")
+{
+  WorldDef3 d3;
+  d3.broad_phase = BroadPhase::grid;
+  auto w3 = std::make_unique<World<3, 600, 4, 600 * 16, 1>>(d3);
+  const std::uint64_t h3 = run_grid_heap<3>(*w3, statsim::testing::cube_synthetic);
+  std::printf("golden grid 3D: 0x%016llx\n", static_cast<unsigned long long>(h3));
+  CHECK(h3 == 0x3b2e2210185f63abull);
+  WorldDef2 d2;
+  d2.broad_phase = BroadPhase::grid;
+  auto w2 = std::make_unique<World<2, 600, 4, 600 * 16, 1>>(d2);
+  const std::uint64_t h2 = run_grid_heap<2>(*w2, statsim::testing::square2d_synthetic);
+  std::printf("golden grid 2D: 0x%016llx\n", static_cast<unsigned long long>(h2));
+  CHECK(h2 == 0xe8cf0a703c9633ccull);
 }

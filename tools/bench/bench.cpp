@@ -271,7 +271,7 @@ public:
         "statsim: WorldDef defaults (broad phase " + statsim_default_broad_phase() +
         "; statistical-sap / statistical-grid force sweep-and-prune / the grid" +
         "; 4 support passes, shock propagation, sleep speed 0.05 m/s for 0.5 s), ground plane, float; world "
-        "capacity: the smallest of 16, 128, 1024, 4096, 16384, 32768 holding N, 32 candidate pairs per body; "
+        "capacity: the smallest of 16, 128, 1024, 4096, 16384, 32768, 131072 holding N, 32 candidate pairs per body; "
         "seed = scene seed");
 
     // Cells, in report order.
