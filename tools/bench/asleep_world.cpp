@@ -1,4 +1,4 @@
-// Standalone measurement, not built by CMake (tools/bench/README.md, "The asleep world"): thread
+// The asleep world of tools/bench/README.md (target bench_asleep_world, build/bin): thread
 // CPU time per step of a world of 10,000 bunnies that are all asleep (added asleep in a lattice on
 // the ground), 1,000 steps, sweep-and-prune and the grid.
 #include "statsim/world3.hpp"
@@ -11,7 +11,7 @@ static double cpu_ms()
 {
   timespec t;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 int main()
 {
