@@ -1,5 +1,6 @@
 // Queries: ray casts (closest and all hits) and sphere overlaps against the bodies' collision
-// spheres and the planes; their statuses; and that they change nothing.
+// spheres and the planes; their statuses; that they change nothing; and that through the broad
+// phase's records they find exactly what a test of every slot finds, reading few records.
 #include <doctest/doctest.h>
 
 #include "scenes/synthetic_signatures.hpp"
