@@ -13,6 +13,7 @@
 #include "bench/bench_internal.hpp"
 #include "scenes/scenes.hpp"
 
+#include "statsim/queries.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 #include "tables/box.hpp"
@@ -1249,15 +1250,27 @@ void Matrix::spawn_remove()
   for (const Vector3& n : {Vector3(1, 0, 0), Vector3(-1, 0, 0), Vector3(0, 1, 0), Vector3(0, -1, 0)})
     set_up = set_up && w->add_plane(n, -wall).ok();
   if (!set_up) throw std::runtime_error("spawn-remove: set-up failed");
-  const Scalar drop = 12 * r;  // above the pile of 24, about 5 R high
+  // Above the pile of 24 (about 5 R high), where no body is: a body dropped every step at one
+  // height would land in the one dropped a step before (it has fallen g dt^2 / 2, 1.4 mm).
+  const Scalar drop_low = 10 * r, drop = 18 * r;
   Pcg32 g(2026, 1);
   scenes::SceneRng qrng(2026);
   std::vector<BodyId> live, stale;
-  long add_failures = 0, remove_failures = 0, stale_accepted = 0, stale_tries = 0, non_finite = 0;
+  long add_failures = 0, remove_failures = 0, stale_accepted = 0, stale_tries = 0, non_finite = 0, no_room = 0;
   const auto spawn = [&](Scalar z) {
     BodyDef3 b;
     b.shape = shape.id;
-    b.position = Vector3(g.uniform(-wall + r, wall - r), g.uniform(-wall + r, wall - r), z);
+    for (int tries = 0; tries < 100; ++tries) {
+      b.position = Vector3(g.uniform(-wall + r, wall - r), g.uniform(-wall + r, wall - r),
+                           z > 0 ? z : g.uniform(drop_low, drop));
+      bool free = true;
+      // Collision spheres apart: a query of radius R (>= the new body's) about the new centre.
+      if (overlap_sphere(*w, b.position, r, [&free](const QueryHit<3>& h) { return free = h.body == no_body; }) !=
+          Status::ok)
+        free = false;
+      if (free) break;
+      if (tries == 99) ++no_room;
+    }
     b.orientation = random_q(qrng).cast<Scalar>();
     const Added<BodyId> a = w->add_body(b);
     if (a.ok()) live.push_back(a.id);
@@ -1282,7 +1295,7 @@ void Matrix::spawn_remove()
     stale.push_back(live[at]);
     live[at] = live.back();
     live.pop_back();
-    spawn(drop);
+    spawn(0);
     // A removed id, from any time in the run, stays refused (also once its slot is reused).
     const BodyId old = stale[g.next_u32() % stale.size()];
     ++stale_tries;
@@ -1314,19 +1327,20 @@ void Matrix::spawn_remove()
     }
   }
   const double vbound = 1.25 * (std::sqrt(2 * kG * double(drop)) + kG * dt);
-  const bool pass = add_failures == 0 && remove_failures == 0 && stale_accepted == 0 && non_finite == 0 && n == std::size_t(live_target) &&
+  const bool pass = add_failures == 0 && remove_failures == 0 && no_room == 0 && stale_accepted == 0 && non_finite == 0 && n == std::size_t(live_target) &&
                     vmax <= vbound && asleep * 100 >= 95 * n && overlap <= 0.2 && lowest >= -0.1;
   add(fmt("spawn-remove %.0f min, pile of %d bunnies", hours * 60, live_target), "statistical", pass,
-      fmt("%ld removals; slots used %u of %u, %u retired (%.0f per hour); add/remove failures %ld/%ld; stale ids accepted "
+      fmt("%ld removals; slots used %u of %u, %u retired (%.0f per hour); add/remove failures %ld/%ld; no room %ld; stale ids accepted "
           "%ld/%ld; non-finite %ld; max speed %.2f m/s; after %.0f s: asleep %zu/%zu, max sphere overlap %.1f%%, "
           "lowest sphere point %+.3f R; %.1f s",
-          steps, slots_used, kCap, retired, retired / hours, add_failures, remove_failures, stale_accepted, stale_tries, non_finite,
+          steps, slots_used, kCap, retired, retired / hours, add_failures, remove_failures, no_room, stale_accepted, stale_tries, non_finite,
           vmax, settle_s, asleep, n, 100 * overlap, lowest, run_s),
-      fmt("every step one body removed and one dropped from %.2f m, in a %u-slot world: no add_body failure "
+      fmt("every step one body removed and one dropped from %.2f to %.2f m where its bounding sphere is clear, in a "
+          "%u-slot world: no add_body failure "
           "while live < capacity, every stale id refused, no non-finite state, max speed <= 1.25 (free-fall "
           "speed + g dt) = %.2f m/s; %.0f s after the last drop: asleep >= 95%%, max sphere overlap <= 20%% of "
           "the radius sum, no sphere below the ground by more than 0.1 R",
-          double(drop), kCap, vbound, settle_s));
+          double(drop_low), double(drop), kCap, vbound, settle_s));
 }
 
 // 11. sizes ---------------------------------------------------------------------------------------------
