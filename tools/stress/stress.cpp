@@ -1335,7 +1335,7 @@ void Matrix::spawn_remove()
           "lowest sphere point %+.3f R; %.1f s",
           steps, slots_used, kCap, retired, retired / hours, add_failures, remove_failures, no_room, stale_accepted, stale_tries, non_finite,
           vmax, settle_s, asleep, n, 100 * overlap, lowest, run_s),
-      fmt("every step one body removed and one dropped from %.2f to %.2f m where its bounding sphere is clear, in a "
+      fmt("every step one body removed and one dropped from %.2f to %.2f m clear of collision spheres, in a "
           "%u-slot world: no add_body failure "
           "while live < capacity, every stale id refused, no non-finite state, max speed <= 1.25 (free-fall "
           "speed + g dt) = %.2f m/s; %.0f s after the last drop: asleep >= 95%%, max sphere overlap <= 20%% of "
