@@ -72,6 +72,7 @@ Added<BodyId> add_body(WorldData<D>& w, const BodyDef<D>& def)
     --slots.free_count;
     --slots.removed;
     w.sweep_current = false;  // the slot's sweep entry is where the removed body was
+    note_moved(w, id);
   } else {
     slots.generation[id] = 0;
     ++w.body_count;
@@ -138,6 +139,7 @@ Status set_transform(WorldData<D>& w, BodyId id, const typename Space<D>::Vec& p
   b.position = position;
   b.orientation = normalized(orientation);
   wake(w, b);
+  note_moved(w, slot);
   return Status::ok;
 }
 

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <new>  // placement new: objects begun in the world's own storage block, nothing allocated
 
 namespace statsim {
@@ -25,6 +26,69 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_
   if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
   if (found < w.max_pairs) w.pairs[found] = a < b ? Pair{a, b} : Pair{b, a};
   ++found;
+}
+
+/// Notes that the broad phase has just made a record of every body where it is now.
+template <int D>
+void made_records(WorldData<D>& w, bool grid)
+{
+  QueryIndex& q = w.index;
+  q.valid = true;
+  q.grid = grid;
+  q.overflow = false;
+  q.axis = w.def.sweep_axis;
+  q.count = w.body_count;
+  q.moved_count = 0;
+  q.drift = 0;
+  q.step = w.step_count;
+}
+
+/// After the contact passes: widens `QueryIndex::drift` to the farthest a body has moved from its
+/// record. Only bodies awake at some time in the step move (a sleeper's inverse mass is 0 in the
+/// passes): those awake now and those that fell asleep in it (`flagged`). The records are read
+/// in their own order, at one bit test each, so a step costs one read of them; it is made only
+/// in steps that made them (in others no body is awake and none moved).
+/// A body gone non-finite is left out: no query can meet it. (The bounds are measured on the
+/// same float sums the records were made of; the queries' margin covers the rest of the rounding.)
+template <int D>
+void measure_drift(WorldData<D>& w)
+{
+  QueryIndex& q = w.index;
+  if (!q.valid || w.step_count != q.step) return;
+  const auto moved = [&w](std::uint32_t i) {
+    const std::uint32_t bit = std::uint32_t(1) << (i % 32);
+    return ((w.awake[i / 32] | w.flagged[i / 32]) & bit) != 0 && finite(w.bodies[i].position);
+  };
+  Scalar drift = q.drift;
+  bool lost = false;
+  if (q.grid) {
+    for (std::uint32_t k = 0; k < q.count; ++k) {
+      const GridItem<D>& it = w.grid.items[k];
+      const std::uint32_t i = it.key & ~asleep_key;
+      if (!moved(i)) continue;
+      const Scalar d = (w.bodies[i].position - it.position).norm();
+      if (d > drift) drift = d;
+      else lost = lost || !(d <= drift);  // a record not finite: queries scan
+    }
+  } else {
+    const Scalar common = w.common_bound;
+    for (std::uint32_t k = 0; k < q.count; ++k) {
+      const SweepEntry& e = w.entries[k];
+      // An entry of a body gone non-finite leaves the entries out of order, where the queries'
+      // binary search would miss others: it makes the drift non-finite, and queries scan.
+      lost = lost || !(e.lo <= e.hi);
+      if (!moved(e.body)) continue;
+      const Body<D>& b = w.bodies[e.body];
+      // The entry's interval against the one the body would have now: the larger shift of its ends.
+      const Scalar bound = common > 0 ? common : w.shapes[b.shape].bounding_radius;
+      const Scalar lo = std::fabs(b.position[q.axis] - bound - e.lo);
+      const Scalar hi = std::fabs(b.position[q.axis] + bound - e.hi);
+      const Scalar d = lo > hi ? lo : hi;
+      if (d > drift) drift = d;
+      else lost = lost || !(d <= drift);  // a record not finite: queries scan
+    }
+  }
+  q.drift = lost ? std::numeric_limits<Scalar>::quiet_NaN() : drift;
 }
 
 /// Pairs from the grid of cells one widest bounding diameter wide: each awake body looks at the
@@ -49,6 +113,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
     return GridItem<D>{b.position, b.state != MotionState::asleep ? i : i + asleep_key};
   };
   grid.build(w.body_count, cell, item);
+  made_records(w, true);
   result.broad_phase_bodies += w.body_count;
   std::uint32_t found = 0, examined = 0;
   constexpr int neighbours = D == 3 ? 27 : 9;
@@ -151,6 +216,7 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   }
   result.broad_phase_bodies += w.body_count;
   insertion_sort(w.entries, w.body_count);
+  made_records(w, false);
   // Nothing moves in a step without awake bodies: the order stays valid for the next.
   w.sweep_current = w.awake_count == 0;
   // Its overlaps are not counted in `StepResult::pairs_examined`: a counter in the sweep's inner
@@ -180,6 +246,7 @@ void switch_broad_phase(WorldData<D>& w)
     }
   }
   w.grid_layout = !w.grid_layout;
+  w.index.valid = false;  // until the phase switched to makes its records
 }
 
 /// Fills the pair buffer with this step's candidate pairs, up to its capacity; the result tells

@@ -221,6 +221,7 @@ class WorldCore {
       for (int i = 0; i < w_.def.position_iterations && moves > 0; ++i) moves = detail::position_pass(w_, ctx);
     }
     detail::update_motion_states(w_, dt, ctx.tilted_planes);
+    detail::measure_drift(w_);
     w_.touching_pairs = ctx.touching;
     result.energy_clamps = ctx.energy_clamps;
     result.statistical_responses = ctx.statistical_responses;

@@ -56,6 +56,26 @@ inline void clear_bit(std::uint32_t* words, std::uint32_t i)
   words[i / 32] &= ~(std::uint32_t(1) << (i % 32));
 }
 
+/// What the queries (statsim/queries.hpp) need to search the broad phase's records instead of
+/// every body: the records are those of the last broad phase that ran, made before the contact
+/// passes moved bodies, so a query widens its search by how far a body has moved since.
+struct QueryIndex {
+  static constexpr std::uint32_t max_moved = 16;  ///< bodies listed in `moved`
+  bool valid = false;  ///< the broad phase's block holds records of bodies [0, `count`)
+  bool grid = false;   ///< the records are the grid's (else sweep-and-prune entries)
+  bool overflow = false;  ///< more bodies were moved than `moved` holds: queries scan every body
+  int axis = 0;  ///< the sweep axis the entries were made on
+  std::uint64_t step = 0;  ///< `WorldData::step_count` of the step that made the records
+  std::uint32_t count = 0;  ///< bodies in the records; those added after them are searched one by one
+  std::uint32_t moved_count = 0;
+  /// Bodies given a new place between steps (`set_transform`, a reused slot's `add_body`):
+  /// their records are not where they are, so queries test them one by one.
+  std::uint32_t moved[max_moved];
+  /// m: no body of the records has moved farther from its record since (along the sweep axis for
+  /// sweep-and-prune), but for the `moved` ones. Not finite: queries scan every body.
+  Scalar drift = 0;
+};
+
 /// A world's storage (owned by `World<>`), counts and parameters: what every phase reads.
 template <int D>
 struct WorldData {
@@ -97,7 +117,19 @@ struct WorldData {
   std::uint64_t statistical_responses = 0;  ///< over the world's life
   WorldDef<D> def{};
   BodySlots slots{};  ///< what names the body in each slot (`remove_body`)
+  QueryIndex index{};  ///< the broad phase's records as the queries see them
 };
+
+/// Records that body `i` was given a new place between steps: its broad phase record (if it has
+/// one) no longer tells where it is.
+template <int D>
+void note_moved(WorldData<D>& w, std::uint32_t i)
+{
+  QueryIndex& q = w.index;
+  if (i >= q.count) return;  // beyond the records: queries test it anyway
+  if (q.moved_count < QueryIndex::max_moved) q.moved[q.moved_count++] = i;
+  else q.overflow = true;
+}
 
 /// What one step counts as its phases run; the passes reset the counter they test.
 struct StepContext {

@@ -14,6 +14,7 @@
 #include "bench/bench_internal.hpp"
 #include "scenes/scenes.hpp"
 
+#include "statsim/queries.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 #include "tables/box.hpp"
@@ -458,6 +459,8 @@ public:
                    [this](const std::string& scene, const std::string& method, bool pass, const std::string& figure,
                           const std::string& criterion) { add(scene, method, pass, figure, criterion); });
   }
+  void spawn_remove();
+  void sizes();
 
   std::unique_ptr<bench::Sim> sim3(const std::string& method, const Setup3& setup,
                                    const std::vector<scenes::BodyState3>& states, double dt) const
@@ -1232,6 +1235,218 @@ void Matrix::mass_ratio()
   }
 }
 
+// 10. spawn and remove --------------------------------------------------------------------------------
+// An hour of simulated time (--quick: 10 minutes) in which every step removes a random body of a
+// small walled pile and drops a new one onto it, and tries ids removed earlier. statsim only (the
+// Bullet methods have no row): it is the id and slot bookkeeping that is under test. Each removal
+// advances its slot's generation; a slot is retired after 4095 (`retired_generation`), so the
+// world needs room for the live bodies plus the slots retired in the run.
+void Matrix::spawn_remove()
+{
+  if (!want("statistical")) return;
+  constexpr std::uint32_t kCap = 256;
+  using W = World3<kCap, 8, kCap * 32, 2>;
+  const int live_target = 24;
+  const double dt = 1.0 / 60, settle_s = 20, hours = opt_.quick ? 1.0 / 6 : 1.0;
+  const long steps = std::lround(hours * 3600 / dt);
+  WorldDef3 def;
+  def.body_contacts = contacts();
+  auto w = std::make_unique<W>(def);
+  const Added<ShapeId> shape = w->add_shape(tables::bunny.view());
+  const Scalar r = Scalar(R()), wall = 4 * r;
+  bool set_up = shape.ok() && w->add_plane(Vector3(0, 0, 1), 0).ok();
+  for (const Vector3& n : {Vector3(1, 0, 0), Vector3(-1, 0, 0), Vector3(0, 1, 0), Vector3(0, -1, 0)})
+    set_up = set_up && w->add_plane(n, -wall).ok();
+  if (!set_up) throw std::runtime_error("spawn-remove: set-up failed");
+  // Above the pile of 24 (about 5 R high), where no body is: a body dropped every step at one
+  // height would land in the one dropped a step before (it has fallen g dt^2 / 2, 1.4 mm).
+  const Scalar drop_low = 10 * r, drop = 18 * r;
+  Pcg32 g(2026, 1);
+  scenes::SceneRng qrng(2026);
+  std::vector<BodyId> live, stale;
+  long add_failures = 0, remove_failures = 0, stale_accepted = 0, stale_tries = 0, non_finite = 0, no_room = 0;
+  const auto spawn = [&](Scalar z) {
+    BodyDef3 b;
+    b.shape = shape.id;
+    for (int tries = 0; tries < 100; ++tries) {
+      b.position = Vector3(g.uniform(-wall + r, wall - r), g.uniform(-wall + r, wall - r),
+                           z > 0 ? z : g.uniform(drop_low, drop));
+      bool free = true;
+      // Collision spheres apart: a query of radius R (>= the new body's) about the new centre.
+      if (overlap_sphere(*w, b.position, r, [&free](const QueryHit<3>& h) { return free = h.body == no_body; }) !=
+          Status::ok)
+        free = false;
+      if (free) break;
+      if (tries == 99) ++no_room;
+    }
+    b.orientation = random_q(qrng).cast<Scalar>();
+    const Added<BodyId> a = w->add_body(b);
+    if (a.ok()) live.push_back(a.id);
+    else add_failures += a.status == Status::capacity_exceeded && w->live_body_count() < kCap;
+  };
+  for (int i = 0; i < live_target; ++i) spawn(r * Scalar(2 + 2 * i));
+  double vmax = 0;
+  std::uint32_t slots_used = 0;
+  const auto check = [&]() {
+    for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+      if (w->id_of(i) == no_body) continue;
+      const Body<3>& b = w->data().bodies[i];
+      const double v = double(b.linear_velocity.norm());
+      if (!std::isfinite(v) || !finite3(b.position.cast<double>())) ++non_finite;
+      else vmax = std::max(vmax, v);
+    }
+  };
+  const Clock::time_point t0 = Clock::now();
+  for (long k = 0; k < steps; ++k) {
+    const std::size_t at = g.next_u32() % live.size();
+    if (w->remove_body(live[at]) != Status::ok) ++remove_failures;
+    stale.push_back(live[at]);
+    live[at] = live.back();
+    live.pop_back();
+    spawn(0);
+    // A removed id, from any time in the run, stays refused (also once its slot is reused).
+    const BodyId old = stale[g.next_u32() % stale.size()];
+    ++stale_tries;
+    stale_accepted += w->alive(old) || w->remove_body(old) != Status::invalid_body ||
+                      w->set_velocity(old, Vector3::Zero(), Vector3::Zero()) != Status::invalid_body;
+    if (w->step(Scalar(dt)).status != Status::ok) ++non_finite;
+    check();
+    slots_used = std::max(slots_used, w->body_count());
+  }
+  const double run_s = seconds_since(t0);
+  for (long k = 0; k < std::lround(settle_s / dt); ++k)
+    if (w->step(Scalar(dt)).status != Status::ok) ++non_finite;
+  check();
+  std::uint32_t retired = 0;
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) retired += w->data().slots.generation[i] == detail::retired_generation;
+  std::size_t asleep = 0, n = 0;
+  double overlap = 0, lowest = kInf;
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) {
+    if (w->id_of(i) == no_body) continue;
+    const Body<3>& a = w->data().bodies[i];
+    ++n;
+    asleep += a.state == MotionState::asleep;
+    lowest = std::min(lowest, double(a.position.z() - a.radius) / R());
+    for (std::uint32_t j = i + 1; j < w->body_count(); ++j) {
+      if (w->id_of(j) == no_body) continue;
+      const Body<3>& b = w->data().bodies[j];
+      const double sum = double(a.radius) + double(b.radius);
+      overlap = std::max(overlap, (sum - double((a.position - b.position).norm())) / sum);
+    }
+  }
+  const double vbound = 1.25 * (std::sqrt(2 * kG * double(drop)) + kG * dt);
+  const bool pass = add_failures == 0 && remove_failures == 0 && no_room == 0 && stale_accepted == 0 && non_finite == 0 && n == std::size_t(live_target) &&
+                    vmax <= vbound && asleep * 100 >= 95 * n && overlap <= 0.2 && lowest >= -0.1;
+  add(fmt("spawn-remove %.0f min, pile of %d bunnies", hours * 60, live_target), "statistical", pass,
+      fmt("%ld removals; slots used %u of %u, %u retired (%.0f per hour); add/remove failures %ld/%ld; no room %ld; stale ids accepted "
+          "%ld/%ld; non-finite %ld; max speed %.2f m/s; after %.0f s: asleep %zu/%zu, max sphere overlap %.1f%%, "
+          "lowest sphere point %+.3f R; %.1f s",
+          steps, slots_used, kCap, retired, retired / hours, add_failures, remove_failures, no_room, stale_accepted, stale_tries, non_finite,
+          vmax, settle_s, asleep, n, 100 * overlap, lowest, run_s),
+      fmt("every step one body removed and one dropped from %.2f to %.2f m clear of collision spheres, in a "
+          "%u-slot world: no add_body failure "
+          "while live < capacity, every stale id refused, no non-finite state, max speed <= 1.25 (free-fall "
+          "speed + g dt) = %.2f m/s; %.0f s after the last drop: asleep >= 95%%, max sphere overlap <= 20%% of "
+          "the radius sum, no sphere below the ground by more than 0.1 R",
+          double(drop_low), double(drop), kCap, vbound, settle_s));
+}
+
+// 11. sizes ---------------------------------------------------------------------------------------------
+/// `body` `s` times its size: lengths times s, mass (same density) s^3, inertia s^5.
+Body3 scaled_body(const Body3& body, double s)
+{
+  Body3 b = body;
+  for (auto& v : b.full_vertices) v *= s;
+  for (auto& v : b.low_vertices) v *= s;
+  for (auto& sp : b.spheres) sp *= s;  // centre and radius
+  for (auto& box : b.boxes) {
+    box.centre *= s;
+    box.half_extents *= s;
+  }
+  b.bounding_radius *= s;
+  b.sphere_radius *= s;
+  b.mass *= s * s * s;
+  b.inertia *= s * s * s * s * s;
+  return b;
+}
+
+// The bunny and the box at 1 cm, 10 cm, 1 m and 10 m (bounding diameter), their tables scaled
+// with `scaled_view` (what `add_shape(sig, scale)` adds) and Bullet's shapes from the scaled
+// meshes: 27 bodies dropped into a walled square, the scene scaled with them (gravity unchanged;
+// drop speeds by sqrt(s) and spins by 1/sqrt(s), so the drop looks the same in units of the body's
+// size and sqrt(size / g); the run 20 sqrt(s) s long). The criteria are in those units too.
+void Matrix::sizes()
+{
+  const double dt = 1.0 / 60;
+  for (const char* name : {"bunny", "box"}) {
+    const Body3 base = std::string(name) == "bunny" ? body_ : bench::load_body3("box", dir_);
+    const SignatureView<3> table = std::string(name) == "bunny" ? tables::bunny.view() : tables::box.view();
+    for (const double size : {0.01, 0.1, 1.0, 10.0}) {
+      const double s = size / (2 * base.bounding_radius);
+      const Body3 body = scaled_body(base, s);
+      const SignatureView<3> sig = scaled_view(table, Scalar(s));
+      const double R = body.bounding_radius, T = 20 * std::sqrt(s);
+      scenes::DropOptions o;
+      o.count = 27;
+      o.bounding_radius = R;
+      o.max_speed = 0.5 * std::sqrt(s);
+      o.max_spin = 2 / std::sqrt(s);
+      const scenes::DropScene3 scene = scenes::drop_scene3(o);
+      double top = 0, v0 = 0;
+      for (const auto& st : scene.bodies) {
+        top = std::max(top, st.position.z());
+        v0 = std::max(v0, st.linear_velocity.norm());
+      }
+      const double vbound = 1.25 * (std::sqrt(v0 * v0 + 2 * kG * top) + kG * dt);
+      Setup3 setup;
+      setup.signature = &sig;
+      const double wall = scene.region.radius + R;
+      setup.planes.push_back({Eigen::Vector3d(1, 0, 0), -wall});
+      setup.planes.push_back({Eigen::Vector3d(-1, 0, 0), -wall});
+      setup.planes.push_back({Eigen::Vector3d(0, 1, 0), -wall});
+      setup.planes.push_back({Eigen::Vector3d(0, -1, 0), -wall});
+      const std::shared_ptr<bench::BulletShapes> shapes = bench::make_bullet_shapes(body);
+      const std::string scene_name = fmt("size %g m %s, 27 dropped", size, name);
+      for (const std::string& m : methods3()) {
+        const bool stat = m == "statistical";
+        std::unique_ptr<bench::Sim> sim;
+        try {
+          sim = make_sim3(body, shapes, m, with_contacts(setup), scene.bodies, dt);
+        } catch (const std::runtime_error&) {
+          continue;  // no such Bullet representation of the shape
+        }
+        const long steps = std::lround(T / dt);
+        double vmax = 0, overlap = 0, lowest = kInf;
+        const Clock::time_point t0 = Clock::now();
+        long done = 0;
+        for (long k = 0; k < steps; ++k, ++done) {
+          if (!stat && seconds_since(t0) > budget()) break;
+          sim->step();
+          vmax = max_speed(*sim, vmax);
+          if (double(k) * dt > T - 5 * std::sqrt(s) && k % 30 == 0) overlap = std::max(overlap, sim->overlap());
+        }
+        std::size_t asleep = 0;
+        for (std::size_t i = 0; i < sim->body_count(); ++i) {
+          asleep += sim->body_asleep(i);
+          lowest = std::min(lowest, sim->lowest(i) / R);
+        }
+        const double over = stat ? overlap : overlap / R;  // statsim: of the radius sum; others: depth / R
+        const bool pass =
+            done == steps && asleep == sim->body_count() && over <= 0.2 && lowest >= -0.1 && vmax <= vbound;
+        add(scene_name, m, pass,
+            fmt("asleep %zu/%zu, max overlap %.1f%% (last %.1f s), lowest point %+.3f R, max speed %.2f m/s "
+                "(bound %.2f)%s",
+                asleep, sim->body_count(), 100 * over, 5 * std::sqrt(s), lowest, vmax, vbound,
+                done < steps ? fmt("; stopped at %.1f s simulated (budget %.0f s wall)", double(done) * dt, budget()).c_str()
+                             : ""),
+            fmt("after %.1f s: all asleep, max overlap <= 20%% (%s), lowest point >= -0.1 R, max speed <= 1.25 "
+                "(free-fall speed + g dt)",
+                T, stat ? "of the collision radius sum" : "penetration over R"));
+      }
+    }
+  }
+}
+
 // 7. bad input -----------------------------------------------------------------------------------------
 template <int D>
 void bad_input_dim(Matrix& mx, const SignatureView<D>& sig, const char* method)
@@ -1355,11 +1570,12 @@ std::vector<StressCell> run_stress(const StressOptions& options)
       {"energy", &Matrix::energy}, {"deep-pile", &Matrix::deep_pile},
       {"long-run", &Matrix::long_run}, {"slopes", &Matrix::slopes},
       {"small-dt", &Matrix::small_time_step}, {"mass-ratio", &Matrix::mass_ratio},
-      {"snapshot", &Matrix::snapshot}};
+      {"snapshot", &Matrix::snapshot}, {"spawn-remove", &Matrix::spawn_remove}, {"sizes", &Matrix::sizes}};
   for (const auto& name : options.scenes)
     if (std::none_of(scenes.begin(), scenes.end(), [&name](const auto& s) { return s.first == name; }))
       throw std::invalid_argument("unknown scene '" + name + "' (bad-input, fast-impact, large-dt, out-of-range, "
-                                  "energy, deep-pile, long-run, slopes, small-dt, mass-ratio, snapshot)");
+                                  "energy, deep-pile, long-run, slopes, small-dt, mass-ratio, snapshot, spawn-remove, "
+                                  "sizes)");
   Matrix mx(options, bench::load_body3("bunny", dir), dir);
   for (const auto& s : scenes)
     if (options.scenes.empty() ||
@@ -1399,7 +1615,7 @@ void register_stress_commands(CLI::App& app)
       ->delimiter(',');
   cmd->add_option("--scenes", opts->scenes,
                   "Scenes (default all): bad-input, fast-impact, large-dt, out-of-range, energy, deep-pile, long-run, "
-                  "slopes, small-dt, mass-ratio, snapshot")
+                  "slopes, small-dt, mass-ratio, snapshot, spawn-remove, sizes")
       ->delimiter(',');
   cmd->add_option("--json", *json, "Write the cells as JSON to FILE");
   cmd->add_flag("--quick", opts->quick, "Smaller scenes: 1,000-bunny pile, 2,000 energy steps, 120 s long run, 36 bunnies per slope");
