@@ -6,6 +6,7 @@
 
 #include "support/snapshot_scene.hpp"
 
+#include "statsim/queries.hpp"
 #include "statsim/snapshot.hpp"
 
 #include <cstdio>
@@ -307,5 +308,40 @@ TEST_CASE("snapshot: refused loads leave the world as it was")
     REQUIRE(twin->step(dt).ok());
     differ += t->state_hash() != twin->state_hash();
   }
+  CHECK(differ == 0);
+}
+
+TEST_CASE("snapshot: queries after a load find what testing every body finds")
+{
+  // World b has stepped a scene of its own, so its broad phase's records are those of other
+  // bodies in other places; after the load the queries must not search them.
+  WorldDef3 def;
+  def.broad_phase = BroadPhase::grid;
+  auto a = std::make_unique<World3s>(def);
+  REQUIRE(build_snapshot_scene<3>(*a, 96, 90));
+  auto b = std::make_unique<World3s>(def);
+  REQUIRE(build_snapshot_scene<3>(*b, 64, 200));
+  const Bytes bytes = save_bytes<3>(*a);
+  REQUIRE(load<3>(*b, bytes.data(), bytes.size()) == Status::ok);
+  int compared = 0, differ = 0;
+  for (int i = -5; i <= 5; ++i)
+    for (int j = -5; j <= 5; ++j)
+      for (int k = 0; k < 8; ++k) {
+        const Vector3 c(Scalar(i) * 0.1f, Scalar(j) * 0.1f, Scalar(k) * 0.1f);
+        std::vector<BodyId> searched, scanned;
+        QueryStats st;
+        const Status s = overlap_sphere<3>(*b, c, 0.15f, [&](const QueryHit<3>& h) {
+          if (h.body != no_body) searched.push_back(h.body);
+          return true;
+        });
+        REQUIRE(s == Status::ok);
+        detail::overlap_sphere_scan(b->data(), c, Scalar(0.15f), [&](const QueryHit<3>& h) {
+          if (h.body != no_body) scanned.push_back(h.body);
+          return true;
+        }, st);
+        compared += !scanned.empty();
+        differ += searched != scanned;
+      }
+  CHECK(compared > 20);
   CHECK(differ == 0);
 }
