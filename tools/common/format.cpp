@@ -2,6 +2,7 @@
 #include "common/format.hpp"
 
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 
@@ -11,6 +12,16 @@ std::string fmt(const char* format, double x)
 {
   char buf[128];
   std::snprintf(buf, sizeof buf, format, x);
+  return buf;
+}
+
+std::string printf_string(const char* format, ...)
+{
+  char buf[512];
+  va_list ap;
+  va_start(ap, format);
+  std::vsnprintf(buf, sizeof buf, format, ap);
+  va_end(ap);
   return buf;
 }
 

@@ -5,6 +5,7 @@
 // is accepted, every loaded world saves the bytes it was loaded from, and the state hashes of
 // the two worlds agree after every step from the first load to the end.
 #include "stress/snapshot_cells.hpp"
+#include "common/format.hpp"
 
 #include "scenes/scenes.hpp"
 #include "statsim/snapshot.hpp"
@@ -12,7 +13,6 @@
 #include "tables/square2d.hpp"
 
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -21,16 +21,6 @@
 
 namespace statsim::tools {
 namespace {
-
-std::string format(const char* f, ...)
-{
-  char buf[512];
-  va_list ap;
-  va_start(ap, f);
-  std::vsnprintf(buf, sizeof buf, f, ap);
-  va_end(ap);
-  return buf;
-}
 
 /// Steps `steps` times, loading at each of `saves`; adds the cell.
 template <int D, class World>
@@ -62,7 +52,7 @@ void run_pile(World& a, World& b, const std::string& scene, const std::string& m
       ++loads;
       again.assign(n, 0);
       round_trips += save(*to, again.data(), n, &n) == Status::ok && again == bytes;
-      asleep += format("%s%u", asleep.empty() ? "" : "/", from->count(MotionState::asleep));
+      asleep += printf_string("%s%u", asleep.empty() ? "" : "/", from->count(MotionState::asleep));
       loaded = true;
       std::swap(from, to);
     }
@@ -70,7 +60,7 @@ void run_pile(World& a, World& b, const std::string& scene, const std::string& m
   const int wanted = int(sizeof saves / sizeof saves[0]);
   const bool pass = loads == wanted && round_trips == wanted && differ == 0 && compared == steps - saves[0];
   add(scene, method, pass,
-      format("%d/%d loads, %d round trips byte-identical, hashes differ at %d of %d steps; asleep at the saves %s of "
+      printf_string("%d/%d loads, %d round trips byte-identical, hashes differ at %d of %d steps; asleep at the saves %s of "
              "%u; largest snapshot %zu bytes (%.1f per body)",
              loads, wanted, round_trips, differ, compared, asleep.c_str(), a.live_body_count(), largest,
              double(largest) / double(a.body_count())),

@@ -9,6 +9,7 @@
 // statistical2d = statsim World2 with tables/square2d.hpp.
 #include "stress/stress.hpp"
 #include "stress/snapshot_cells.hpp"
+#include "common/format.hpp"
 #include "common/commands.hpp"
 
 #include "bench/bench_internal.hpp"
@@ -28,7 +29,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -50,16 +50,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 const std::vector<std::string> kMethods3 = {"full", "low", "spheres7", "sphere", "statistical"};
 const std::vector<std::string> kMethods2 = {"polygon", "statistical2d"};
-
-std::string fmt(const char* f, ...)
-{
-  char buf[512];
-  va_list ap;
-  va_start(ap, f);
-  std::vsnprintf(buf, sizeof buf, f, ap);
-  va_end(ap);
-  return buf;
-}
 
 double seconds_since(Clock::time_point t0)
 {
@@ -501,9 +491,9 @@ void Matrix::fast_impact()
   const double dt = 1.0 / 60, T = 1.5;
   const int steps = static_cast<int>(std::lround(T / dt));
   for (const double speed : {5.0, 20.0, 50.0}) {
-    const std::string scene = fmt("fast impact %.0f m/s", speed);
+    const std::string scene = printf_string("fast impact %.0f m/s", speed);
     // Tunnelled: the centre ever more than R below the ground, or below it at the end.
-    const std::string criterion = fmt("tunnelled (centre ever below -R, or below 0 at the end) = 0 and max "
+    const std::string criterion = printf_string("tunnelled (centre ever below -R, or below 0 at the end) = 0 and max "
                                       "penetration <= 0.25 R (%.1f cm)",
                                       25 * R());
     std::vector<scenes::BodyState3> states;
@@ -533,7 +523,7 @@ void Matrix::fast_impact()
       for (std::size_t i = 0; i < sim->body_count(); ++i)
         tunnelled += through[i] || sim->body_state(i).position.z() < 0;
       add(scene, m, tunnelled == 0 && pen <= 0.25 * R(),
-          fmt("tunnelled %d/%zu, max penetration %.1f cm", tunnelled, states.size(), 100 * pen), criterion);
+          printf_string("tunnelled %d/%zu, max penetration %.1f cm", tunnelled, states.size(), 100 * pen), criterion);
     }
     // 2D: unit squares (R = 0.707 m).
     std::vector<scenes::BodyState2> states2;
@@ -568,8 +558,8 @@ void Matrix::fast_impact()
       int tunnelled = 0;
       for (std::size_t i = 0; i < sim->size(); ++i) tunnelled += through[i] || sim->state(i).x.y() < 0;
       add(scene + " (2D)", m, tunnelled == 0 && pen <= 0.25 * r2,
-          fmt("tunnelled %d/%zu, max penetration %.1f cm", tunnelled, states2.size(), 100 * pen),
-          fmt("tunnelled (centre ever below -R, or below 0 at the end) = 0 and max penetration <= 0.25 R "
+          printf_string("tunnelled %d/%zu, max penetration %.1f cm", tunnelled, states2.size(), 100 * pen),
+          printf_string("tunnelled (centre ever below -R, or below 0 at the end) = 0 and max penetration <= 0.25 R "
               "(%.1f cm)",
               25 * r2));
     }
@@ -592,9 +582,9 @@ void Matrix::large_time_step()
     const double dt = 1 / hz, T = 10;
     const int steps = static_cast<int>(std::lround(T / dt));
     const double bound = 1.25 * (std::sqrt(v0 * v0 + 2 * kG * top) + kG * dt);
-    const std::string name = fmt("large dt 1/%.0f, 50-bunny drop", hz);
+    const std::string name = printf_string("large dt 1/%.0f, 50-bunny drop", hz);
     const std::string criterion =
-        fmt("lost = 0 and max speed <= 1.25 (free-fall speed + g dt) = %.1f m/s", bound);
+        printf_string("lost = 0 and max speed <= 1.25 (free-fall speed + g dt) = %.1f m/s", bound);
     for (const std::string& m : methods3()) {
       auto sim = sim3(m, Setup3{}, scene.bodies, dt);
       double vmax = 0;
@@ -607,7 +597,7 @@ void Matrix::large_time_step()
         const Eigen::Vector3d x = sim->body_state(i).position;
         lost += !finite3(x) || x.z() < -R() || std::fabs(x.x()) > 50 || std::fabs(x.y()) > 50;
       }
-      add(name, m, lost == 0 && vmax <= bound, fmt("max speed %.2f m/s, lost %d/50", vmax, lost), criterion);
+      add(name, m, lost == 0 && vmax <= bound, printf_string("max speed %.2f m/s, lost %d/50", vmax, lost), criterion);
     }
   }
 }
@@ -627,16 +617,16 @@ void Matrix::deep_pile()
   setup.planes.push_back({Eigen::Vector3d(0, -1, 0), -wall});
   const double dt = 1.0 / 60, T = 20;
   const int steps = static_cast<int>(std::lround(T / dt));
-  const std::string name = fmt("deep pile %d bunnies, 5 planes", o.count);
+  const std::string name = printf_string("deep pile %d bunnies, 5 planes", o.count);
   const double ke_per_body = 1e-3;
   for (const std::string& m : methods3()) {
     const bool stat = m == "statistical";
     const std::string criterion =
-        fmt("after 20 s: asleep >= 95%%, kinetic energy <= %.0e J per body, ", ke_per_body) +
+        printf_string("after 20 s: asleep >= 95%%, kinetic energy <= %.0e J per body, ", ke_per_body) +
         (stat ? std::string(opt_.hull_contacts ? "max hull overlap <= 20% of the separation the hulls touch at"
                                                 : "max sphere overlap <= 20% of the radius sum") +
                      " (each second of the last 5 s)"
-              : fmt("max contact penetration <= 0.2 R = %.1f cm (each second of the last 5 s)", 20 * R()));
+              : printf_string("max contact penetration <= 0.2 R = %.1f cm (each second of the last 5 s)", 20 * R()));
     const Clock::time_point t0 = Clock::now();
     auto sim = sim3(m, setup, scene.bodies, dt);
     const double build_s = seconds_since(t0);
@@ -666,24 +656,24 @@ void Matrix::deep_pile()
     const double ke = sim->kinetic_energy();
     const double frac = double(asleep) / double(sim->body_count());
     const double ms = 1e3 * step_s / std::max(done, 1);
-    std::string figure = fmt("KE %.3g J (%.2g J/body), asleep %.1f%%, ", ke, ke / double(sim->body_count()), 100 * frac) +
-                         (stat ? fmt(opt_.hull_contacts ? "max overlap %.1f%% of the hulls' reach (whole run %.1f%%)"
+    std::string figure = printf_string("KE %.3g J (%.2g J/body), asleep %.1f%%, ", ke, ke / double(sim->body_count()), 100 * frac) +
+                         (stat ? printf_string(opt_.hull_contacts ? "max overlap %.1f%% of the hulls' reach (whole run %.1f%%)"
                                                        : "max overlap %.1f%% of radius sum (whole run %.1f%%)",
                                      100 * overlap,
                                      100 * overlap_all)
-                               : fmt("max penetration %.2f cm (whole run %.2f cm)", 100 * overlap,
+                               : printf_string("max penetration %.2f cm (whole run %.2f cm)", 100 * overlap,
                                      100 * overlap_all)) +
-                         fmt(", %.2f ms/step", ms);
+                         printf_string(", %.2f ms/step", ms);
     bool pass = frac >= 0.95 && ke <= ke_per_body * double(sim->body_count()) && overlap <= (stat ? 0.2 : 0.2 * R());
     if (done < steps) {
-      figure += fmt("; stopped at %.1f s simulated (budget %.0f s wall)", done * dt, budget());
+      figure += printf_string("; stopped at %.1f s simulated (budget %.0f s wall)", done * dt, budget());
       pass = false;
     }
     if (stat) {
       const auto* s = dynamic_cast<const StatsimSim3<16384>*>(sim.get());
       const auto* s1 = dynamic_cast<const StatsimSim3<1024>*>(sim.get());
       const std::uint32_t dropped = s ? s->pairs_dropped() : (s1 ? s1->pairs_dropped() : 0);
-      if (dropped) figure += fmt("; pair buffer overflow (up to %u dropped)", dropped);
+      if (dropped) figure += printf_string("; pair buffer overflow (up to %u dropped)", dropped);
     }
     add(name, m, pass, figure, criterion);
   }
@@ -750,23 +740,23 @@ void Matrix::energy()
       }
     }
     const double ke1 = sim->kinetic_energy();
-    std::string figure = fmt("KE0 %.4g J; max %+.3g%%, end %+.3g%% (drift)", ke0, 100 * (hi / ke0 - 1),
+    std::string figure = printf_string("KE0 %.4g J; max %+.3g%%, end %+.3g%% (drift)", ke0, 100 * (hi / ke0 - 1),
                              100 * (ke1 / ke0 - 1));
     bool pass = hi <= ke0 * (1 + 1e-5);
     if (done < steps) {
-      figure += fmt("; stopped after %d of %d steps (budget)", done, steps);
+      figure += printf_string("; stopped after %d of %d steps (budget)", done, steps);
       pass = false;
     }
     add(scene, label, pass, figure, criterion);
   };
-  const std::string scene = fmt("energy, elastic box, %d steps", steps);
+  const std::string scene = printf_string("energy, elastic box, %d steps", steps);
   for (const std::string& m : methods3()) {
     Setup3 s = setup;
     s.particle = m == "statistical";
     run(scene, m == "statistical" ? "statistical" : m, sim3(m, s, states, dt), m == "statistical");
   }
   if (want("statistical"))
-    run(fmt("energy, statistical responses, %d steps", steps), "statistical",
+    run(printf_string("energy, statistical responses, %d steps", steps), "statistical",
         sim3("statistical", setup, states, dt), true);
 }
 
@@ -801,7 +791,7 @@ void Matrix::out_of_range()
     }
     c.speed_bound = v + kG * c.T;
     c.energy = true;  // a spinning body may rightly turn spin into speed at an impact
-    c.name += fmt(" (|v| = %.0f m/s, |w| = %.3g rad/s)", v, w);
+    c.name += printf_string(" (|v| = %.0f m/s, |w| = %.3g rad/s)", v, w);
     cases.push_back(c);
   }
   {
@@ -874,25 +864,25 @@ void Matrix::out_of_range()
         lost += !bad && s.position.z() < -R();
         if (!bad) displaced = std::max(displaced, (s.position - states[i].position).norm());
       }
-      std::string figure = fmt("non-finite %d, lost %d, max speed %.3g m/s", nan, lost, vmax);
-      std::string criterion = fmt("no non-finite state, nothing below the ground, max speed <= %.3g m/s",
+      std::string figure = printf_string("non-finite %d, lost %d, max speed %.3g m/s", nan, lost, vmax);
+      std::string criterion = printf_string("no non-finite state, nothing below the ground, max speed <= %.3g m/s",
                                   c.speed_bound);
       bool pass = nan == 0 && lost == 0 && vmax <= c.speed_bound;
       if (c.energy) {
-        figure += fmt(", total energy max %+.3g%% of its start %.4g J", 100 * (emax / e0 - 1), e0);
+        figure += printf_string(", total energy max %+.3g%% of its start %.4g J", 100 * (emax / e0 - 1), e0);
         criterion = "no non-finite state, nothing below the ground, total energy (kinetic with spin + potential) "
                     "never above its start (+0.1%)";
         pass = nan == 0 && lost == 0 && emax <= e0 * 1.001;
       }
       if (c.at_rest) {
-        figure += fmt(", final displacement %.2f cm", 100 * displaced);
+        figure += printf_string(", final displacement %.2f cm", 100 * displaced);
         criterion += ", final displacement <= 0.25 R";
         pass = pass && displaced <= 0.25 * R();
       }
       if (c.name.rfind("two bodies", 0) == 0) {
         const double sep1 = (sim->body_state(0).position - sim->body_state(1).position).norm();
         const double sep2 = (sim->body_state(2).position - sim->body_state(3).position).norm();
-        figure += fmt(", final separations %.3f and %.3f m", sep1, sep2);
+        figure += printf_string(", final separations %.3f and %.3f m", sep1, sep2);
       }
       add("out of range: " + c.name, m, pass, figure, criterion);
     }
@@ -963,7 +953,7 @@ std::string slope_summary(const SlopeRun& r, double& mean, std::size_t& asleep)
     mean += d[i] / double(d.size());
     asleep += r.asleep[i];
   }
-  return fmt("asleep %zu/%zu, slid mean %.1f cm (p10 %.1f, median %.1f, p90 %.1f, max %.1f cm)", asleep, d.size(),
+  return printf_string("asleep %zu/%zu, slid mean %.1f cm (p10 %.1f, median %.1f, p90 %.1f, max %.1f cm)", asleep, d.size(),
              100 * mean, 100 * quantile(d, 0.1), 100 * quantile(d, 0.5), 100 * quantile(d, 0.9), 100 * d.back());
 }
 
@@ -994,12 +984,12 @@ void Matrix::slopes()
       const bool close = std::fabs(mean - ref_mean) <= 0.2 * std::fabs(ref_mean);
       if (rests)
         add(name, m, asleep == n && close, figure,
-            fmt("every body asleep 10 s after landing and mean distance slid within 20%% of the reference's (%s: "
+            printf_string("every body asleep 10 s after landing and mean distance slid within 20%% of the reference's (%s: "
                 "%.1f cm, %zu/%zu asleep)",
                 ref_name.c_str(), 100 * ref_mean, ref_asleep, n));
       else
         add(name, m, std::fabs(double(asleep) - double(ref_asleep)) <= 0.1 * double(n) && close, figure,
-            fmt("slides as the reference: share asleep 10 s after landing within 0.1 and mean distance slid within "
+            printf_string("slides as the reference: share asleep 10 s after landing within 0.1 and mean distance slid within "
                 "20%% of the reference's (%s: %zu/%zu asleep, %.1f cm)",
                 ref_name.c_str(), ref_asleep, n, 100 * ref_mean));
     };
@@ -1030,7 +1020,7 @@ void Matrix::slopes()
           [&](const Eigen::Vector3d& x) { return x.dot(normal); },
           [&](const Eigen::Vector3d& x) { return x.dot(downhill); });
     };
-    const std::string name = fmt("slope %.0f deg, %zu bunnies, friction 0.5", degrees, states.size());
+    const std::string name = printf_string("slope %.0f deg, %zu bunnies, friction 0.5", degrees, states.size());
     const std::vector<std::string> methods = methods3();
     if (!methods.empty()) {
       const SlopeRun ref = run3("full", kSlopeReferenceSubsteps);
@@ -1069,7 +1059,7 @@ void Matrix::slopes()
           [&](const Eigen::Vector2d& x) { return x.dot(normal2); },
           [&](const Eigen::Vector2d& x) { return x.dot(downhill2); });
     };
-    const std::string name2 = fmt("slope %.0f deg, 20 squares (2D), friction 0.5", degrees);
+    const std::string name2 = printf_string("slope %.0f deg, 20 squares (2D), friction 0.5", degrees);
     const SlopeRun ref2 = run2("polygon", kSlopeReferenceSubsteps);
     double mean2;
     std::size_t asleep2;
@@ -1130,9 +1120,9 @@ void Matrix::long_run()
       }
     }
   }
-  add(fmt("long run %.0f s, 1000 bunnies", T), "statistical",
+  add(printf_string("long run %.0f s, 1000 bunnies", T), "statistical",
       nan == 0 && sleeper_drift <= 1e-6 && hashes[0] == hashes[1],
-      fmt("non-finite %d, drift of sleepers %.3g m, largest move since %.0f s %.3g m, awake at end %zu, hashes "
+      printf_string("non-finite %d, drift of sleepers %.3g m, largest move since %.0f s %.3g m, awake at end %zu, hashes "
           "%016llx %s, %.3f ms/step",
           nan, sleeper_drift, snapshot, creep, awake_end, static_cast<unsigned long long>(hashes[0]),
           hashes[0] == hashes[1] ? "equal" : "DIFFER", ms),
@@ -1152,8 +1142,8 @@ void Matrix::small_time_step()
   for (const double hz : {240.0, 1000.0}) {
     const double dt = 1 / hz, T = 10;
     const long steps = std::lround(T / dt);
-    const std::string name = fmt("small dt 1/%.0f, 50-bunny drop, 10 s", hz);
-    const std::string criterion = fmt("lost = 0, asleep >= 95%% at the end, deepest point of the method's "
+    const std::string name = printf_string("small dt 1/%.0f, 50-bunny drop, 10 s", hz);
+    const std::string criterion = printf_string("lost = 0, asleep >= 95%% at the end, deepest point of the method's "
                                       "geometry below the ground <= 0.25 R (%.1f cm) after each step",
                                       25 * R());
     for (const std::string& m : methods3()) {
@@ -1175,10 +1165,10 @@ void Matrix::small_time_step()
         lost += !finite3(x) || x.z() < -R() || std::fabs(x.x()) > 50 || std::fabs(x.y()) > 50;
       }
       const double asleep = double(sim->asleep()) / double(sim->body_count());
-      std::string figure = fmt("lost %d/50, asleep %.0f%%, deepest %.2f cm", lost, 100 * asleep, 100 * pen);
+      std::string figure = printf_string("lost %d/50, asleep %.0f%%, deepest %.2f cm", lost, 100 * asleep, 100 * pen);
       bool pass = lost == 0 && asleep >= 0.95 && pen <= 0.25 * R();
       if (done < steps) {
-        figure += fmt("; stopped at %.1f s simulated (budget %.0f s wall)", double(done) * dt, budget());
+        figure += printf_string("; stopped at %.1f s simulated (budget %.0f s wall)", double(done) * dt, budget());
         pass = false;
       }
       add(name, m, pass, figure, criterion);
@@ -1199,8 +1189,8 @@ void Matrix::mass_ratio()
   const int n = 3;
   std::vector<scenes::BodyState3> states(n);
   for (int i = 0; i < n; ++i) states[i].position = Eigen::Vector3d(0, 0, half * (2 * i + 1));
-  const std::string name = fmt("mass ratio %.0f, column of 3 cubes", ratio);
-  const std::string criterion = fmt("after %.0f s: top within 2%% of its height with equal masses, all asleep, "
+  const std::string name = printf_string("mass ratio %.0f, column of 3 cubes", ratio);
+  const std::string criterion = printf_string("after %.0f s: top within 2%% of its height with equal masses, all asleep, "
                                     "bottom centre >= 0.5 half side above the ground",
                                     T);
   for (const std::string& m : methods3()) {
@@ -1229,7 +1219,7 @@ void Matrix::mass_ratio()
     const bool pass = finite && std::fabs(top[1] - top[0]) <= 0.02 * top[0] && asleep == std::size_t(n) &&
                       bottom >= 0.5 * half;
     add(name, m, pass,
-        fmt("top %.3f m (equal masses %.3f m, %+.1f%%), bottom %.3f m, asleep %zu/%d%s", top[1], top[0],
+        printf_string("top %.3f m (equal masses %.3f m, %+.1f%%), bottom %.3f m, asleep %zu/%d%s", top[1], top[0],
             100 * (top[1] / top[0] - 1), bottom, asleep, n, finite ? "" : ", NON-FINITE"),
         criterion);
   }
@@ -1285,6 +1275,10 @@ void Matrix::spawn_remove()
     else add_failures += a.status == Status::capacity_exceeded && w->live_body_count() < kCap;
   };
   for (int i = 0; i < live_target; ++i) spawn(r * Scalar(2 + 2 * i));
+  // The first pile is a column released from up to 48 R, higher than any later drop: it settles
+  // before the hour begins, so that the speed bound is that of the drops the hour makes.
+  for (long k = 0; k < std::lround(settle_s / dt); ++k)
+    if (w->step(Scalar(dt)).status != Status::ok) ++non_finite;
   double vmax = 0;
   std::uint32_t slots_used = 0;
   const auto check = [&]() {
@@ -1337,13 +1331,13 @@ void Matrix::spawn_remove()
   const double vbound = 1.25 * (std::sqrt(2 * kG * double(drop)) + kG * dt);
   const bool pass = add_failures == 0 && remove_failures == 0 && no_room == 0 && stale_accepted == 0 && non_finite == 0 && n == std::size_t(live_target) &&
                     vmax <= vbound && asleep * 100 >= 95 * n && overlap <= 0.2 && lowest >= -0.1;
-  add(fmt("spawn-remove %.0f min, pile of %d bunnies", hours * 60, live_target), "statistical", pass,
-      fmt("%ld removals; slots used %u of %u, %u retired (%.0f per hour); add/remove failures %ld/%ld; no room %ld; stale ids accepted "
+  add(printf_string("spawn-remove %.0f min, pile of %d bunnies", hours * 60, live_target), "statistical", pass,
+      printf_string("%ld removals; slots used %u of %u, %u retired (%.0f per hour); add/remove failures %ld/%ld; no room %ld; stale ids accepted "
           "%ld/%ld; non-finite %ld; max speed %.2f m/s; after %.0f s: asleep %zu/%zu, max sphere overlap %.1f%%, "
           "lowest sphere point %+.3f R; %.1f s",
           steps, slots_used, kCap, retired, retired / hours, add_failures, remove_failures, no_room, stale_accepted, stale_tries, non_finite,
           vmax, settle_s, asleep, n, 100 * overlap, lowest, run_s),
-      fmt("every step one body removed and one dropped from %.2f to %.2f m clear of collision spheres, in a "
+      printf_string("every step one body removed and one dropped from %.2f to %.2f m clear of collision spheres, in a "
           "%u-slot world: no add_body failure "
           "while live < capacity, every stale id refused, no non-finite state, max speed <= 1.25 (free-fall "
           "speed + g dt) = %.2f m/s; %.0f s after the last drop: asleep >= 95%%, max sphere overlap <= 20%% of "
@@ -1406,7 +1400,7 @@ void Matrix::sizes()
       setup.planes.push_back({Eigen::Vector3d(0, 1, 0), -wall});
       setup.planes.push_back({Eigen::Vector3d(0, -1, 0), -wall});
       const std::shared_ptr<bench::BulletShapes> shapes = bench::make_bullet_shapes(body);
-      const std::string scene_name = fmt("size %g m %s, 27 dropped", size, name);
+      const std::string scene_name = printf_string("size %g m %s, 27 dropped", size, name);
       for (const std::string& m : methods3()) {
         const bool stat = m == "statistical";
         std::unique_ptr<bench::Sim> sim;
@@ -1434,12 +1428,12 @@ void Matrix::sizes()
         const bool pass =
             done == steps && asleep == sim->body_count() && over <= 0.2 && lowest >= -0.1 && vmax <= vbound;
         add(scene_name, m, pass,
-            fmt("asleep %zu/%zu, max overlap %.1f%% (last %.1f s), lowest point %+.3f R, max speed %.2f m/s "
+            printf_string("asleep %zu/%zu, max overlap %.1f%% (last %.1f s), lowest point %+.3f R, max speed %.2f m/s "
                 "(bound %.2f)%s",
                 asleep, sim->body_count(), 100 * over, 5 * std::sqrt(s), lowest, vmax, vbound,
-                done < steps ? fmt("; stopped at %.1f s simulated (budget %.0f s wall)", double(done) * dt, budget()).c_str()
+                done < steps ? printf_string("; stopped at %.1f s simulated (budget %.0f s wall)", double(done) * dt, budget()).c_str()
                              : ""),
-            fmt("after %.1f s: all asleep, max overlap <= 20%% (%s), lowest point >= -0.1 R, max speed <= 1.25 "
+            printf_string("after %.1f s: all asleep, max overlap <= 20%% (%s), lowest point >= -0.1 R, max speed <= 1.25 "
                 "(free-fall speed + g dt)",
                 T, stat ? "of the collision radius sum" : "penetration over R"));
       }
@@ -1542,7 +1536,7 @@ void bad_input_dim(Matrix& mx, const SignatureView<D>& sig, const char* method)
     }
     const bool unchanged = w->state_hash() == before && w->body_count() == bodies && w->plane_count() == planes;
     mx.add(std::string("bad input: ") + c.name, method, got == c.expected && unchanged,
-           fmt("%s, world %s", to_string(got), unchanged ? "unchanged" : "CHANGED"),
+           printf_string("%s, world %s", to_string(got), unchanged ? "unchanged" : "CHANGED"),
            std::string("rejected with ") + to_string(c.expected) + ", state hash and counts unchanged");
   }
 }
