@@ -973,7 +973,10 @@ void Matrix::slopes()
   const int side = opt_.quick ? 6 : 10;
   for (const double degrees : {10.0, 20.0, 35.0}) {
     const double a = degrees * 3.14159265358979323846 / 180;
-    const bool rests = std::tan(a) < 0.5;
+    // The same test on every tilt: the bodies rest where the reference's rest and move on where
+    // they move on. On 10 and 20 degrees tan(a) is below the friction, yet reference bunnies roll
+    // on their curved backs and some are still moving 10 s after landing (README, "Slopes"):
+    // requiring every body asleep there would require what the reference does not do.
     const auto judge = [&](const std::string& name, const std::string& m, const SlopeRun& r, const SlopeRun& ref,
                            const std::string& ref_name) {
       double mean = 0, ref_mean = 0;
@@ -982,16 +985,10 @@ void Matrix::slopes()
       const std::string figure = slope_summary(r, mean, asleep);
       slope_summary(ref, ref_mean, ref_asleep);
       const bool close = std::fabs(mean - ref_mean) <= 0.2 * std::fabs(ref_mean);
-      if (rests)
-        add(name, m, asleep == n && close, figure,
-            printf_string("every body asleep 10 s after landing and mean distance slid within 20%% of the reference's (%s: "
-                "%.1f cm, %zu/%zu asleep)",
-                ref_name.c_str(), 100 * ref_mean, ref_asleep, n));
-      else
-        add(name, m, std::fabs(double(asleep) - double(ref_asleep)) <= 0.1 * double(n) && close, figure,
-            printf_string("slides as the reference: share asleep 10 s after landing within 0.1 and mean distance slid within "
-                "20%% of the reference's (%s: %zu/%zu asleep, %.1f cm)",
-                ref_name.c_str(), ref_asleep, n, 100 * ref_mean));
+      add(name, m, std::fabs(double(asleep) - double(ref_asleep)) <= 0.1 * double(n) && close, figure,
+          printf_string("rests and moves on as the reference: share asleep 10 s after landing within 0.1 and mean "
+                        "distance slid within 20%% of the reference's (%s: %zu/%zu asleep, %.1f cm)",
+                        ref_name.c_str(), ref_asleep, n, 100 * ref_mean));
     };
 
     // 3D
