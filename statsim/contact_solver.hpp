@@ -24,6 +24,7 @@
 /// energy, so the pile never sleeps.
 
 #include "statsim/hull_contact.hpp"
+#include "statsim/slope_contact.hpp"
 #include "statsim/tipping.hpp"
 #include "statsim/world_data.hpp"
 
@@ -51,7 +52,8 @@ constexpr Scalar contact_slop = Scalar(1e-3);
 /// `tilted_plane`: the contact is with a plane that gravity pulls the body along.
 template <int D>
 void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const typename Space<D>::Vec& n,
-                   const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false)
+                   const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false,
+                   Scalar gap = 0)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& shape = w.shapes[b.shape];
@@ -73,6 +75,14 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
     if (threshold < gravity_step) threshold = gravity_step;
   }
   const bool resting = -v.dot(n) <= threshold;
+  // On a slope a body with no rest pose meets the plane with its hull, as a rigid body does, its
+  // impacts included (statsim/slope_contact.hpp): how far it tumbles and rolls downhill follows
+  // from the strikes of its faces one after the other, each set by the last, which independent
+  // samples of the tables' single-impact responses do not reproduce.
+  if (tilted_plane && rolls_on(w, b, n)) {
+    slope_hull_response(shape, b, n, def.gravity, gap, ctx.dt, threshold);
+    return;
+  }
   if (shape.statistical && tilted_plane && resting && !(ground_contact && b.rest_pose != no_rest_pose)) {
     // Rolling resistance taken off the velocity of a point without lever arm brakes its sliding
     // as extra friction: a slide down the plane at g (sin a - (mu + c) cos a) instead of
@@ -189,26 +199,6 @@ void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D
   ++ctx.moves;
 }
 
-/// True when the plane of unit normal `n` is tilted: it carries weight (n.g < 0) and gravity
-/// `g` pulls along it (a part that is not exactly zero). Writes g.n to `gn`.
-template <class Vec>
-bool is_tilted_plane(const Vec& g, const Vec& n, Scalar& gn)
-{
-  gn = g.dot(n);
-  return gn < 0 && (g - n * gn).squaredNorm() > 0;
-}
-
-/// True when some plane is tilted: only then does `plane_contacts` test each contact for one.
-/// Once per step (planes and gravity do not change within one).
-template <int D>
-bool any_tilted_plane(const WorldData<D>& w)
-{
-  Scalar gn;
-  for (std::uint32_t p = 0; p < w.plane_count; ++p)
-    if (is_tilted_plane(w.def.gravity, w.planes[p].normal, gn)) return true;
-  return false;
-}
-
 /// The shared loop over plane contacts: for every awake body and plane that touch (spheres grown
 /// by `contact_slop` when `grown`), moves the body out of the plane, marks it touching (and on
 /// the ground for a near-horizontal plane), then calls `respond(body, contact, ground, tilted)`
@@ -225,14 +215,22 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
     Body<D>& b = w.bodies[i];
     for (std::uint32_t p = 0; p < w.plane_count; ++p) {
       Contact<D> c;
-      // Passes after the impact pass also see a body that the last pass left exactly touching.
-      const Scalar slop = grown ? b.radius * contact_slop : Scalar(0);
+      // Passes after the impact pass also see a body that the last pass left exactly touching. A
+      // body that meets a slope with its hull is seen within `slope_reach` of its bounding radius
+      // (a speculative contact: `slope_hull_response` lets it close the gap in the step and no
+      // more): turning about a corner, the hull's support falls away from the plane by about
+      // (1 - cos(w dt)) times the support in a step, and the corner would lose the plane.
+      const bool hull = ctx.tilted_planes && rolls_on(w, b, w.planes[p].normal);
+      const Scalar slop = hull ? w.shapes[b.shape].bounding_radius * slope_reach
+                               : (grown ? b.radius * contact_slop : Scalar(0));
       if (!sphere_plane_contact<D>(b.position, plane_radius(w, b, w.planes[p]) + slop, w.planes[p], c)) continue;
       if (c.depth > slop) {
         b.position += c.normal * (c.depth - slop);
         ++ctx.moves;
         ++ctx.changes;
       }
+      // From here on the depth is that of the body itself: 0 once moved out, or minus the gap.
+      c.depth = c.depth > slop ? Scalar(0) : c.depth - slop;
       b.touching = true;
       const bool ground = c.normal[Space<D>::up_axis] >= w.def.ground_cosine;
       b.on_ground = b.on_ground || ground;
@@ -310,7 +308,12 @@ void forget_contacts(WorldData<D>& w)
 template <int D>
 void support_planes(WorldData<D>& w, StepContext& ctx)
 {
-  plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool) {
+  plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool tilted) {
+    if (tilted && rolls_on(w, b, c.normal)) {
+      if (slope_hull_response(w.shapes[b.shape], b, c.normal, w.def.gravity, -c.depth, ctx.dt, no_bounce))
+        ++ctx.changes;
+      return;
+    }
     if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
                                    w.shapes[b.shape].material, no_bounce))
       ++ctx.changes;
@@ -327,7 +330,7 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
   const WorldDef<D>& def = w.def;
   const std::uint32_t plane_count = plane_contacts(w, ctx, false, [&](Body<D>& b, const Contact<D>& c, bool ground,
                                                                       bool tilted) {
-    if (w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground, tilted);
+    if (w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground, tilted, -c.depth);
     else if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
                                         w.shapes[b.shape].material, def.restitution_threshold))
       ++ctx.changes;

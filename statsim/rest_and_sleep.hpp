@@ -5,6 +5,7 @@
 /// (moving, settling, asleep).
 
 #include "statsim/hull_contact.hpp"
+#include "statsim/slope_contact.hpp"
 #include "statsim/tipping.hpp"
 #include "statsim/world_data.hpp"
 
@@ -62,8 +63,13 @@ void update_radii(WorldData<D>& w)
     // A settling body's sphere changes size about its lowest point, so a body blending to its
     // rest height settles smoothly instead of dropping (paper 3.4); on the ground that point is
     // below the centre along the plane's normal.
-    if (b.on_ground) b.position += ground_normal(w, b) * (blended - b.radius);
-    else if (b.pile_rest) b.position[Space<D>::up_axis] += blended - b.radius;
+    // (On a slope the body keeps its hull's support from the plane instead: `hull_radius`.)
+    if (b.on_ground) {
+      const Vec n = ground_normal(w, b);
+      if (!slope_hull(w, b, n)) b.position += n * (blended - b.radius);
+    } else if (b.pile_rest) {
+      b.position[Space<D>::up_axis] += blended - b.radius;
+    }
     b.radius = blended;
   });
 }
@@ -221,7 +227,11 @@ void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
     const bool settling = b.touching && speed2 < settle2;
     const Vec ground = settling && b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
     // On a slope a pose steeper than its tipping angle is no rest pose (`settle_on_slope`).
-    const SlopeSettle slope = tilted_planes && settling && b.on_ground ? settle_on_slope(w, b, ground)
+    // A body rolling on its hull down a slope (statsim/slope_contact.hpp) takes a pose only once
+    // its contacts have all but stopped it there: the faces it rolls over are not poses it rests in.
+    const bool rolling = tilted_planes && settling && b.on_ground && speed2 >= sleep2 && rolls_on(w, b, ground);
+    const SlopeSettle slope = rolling                                   ? SlopeSettle::tipping
+                              : tilted_planes && settling && b.on_ground ? settle_on_slope(w, b, ground)
                                                                          : SlopeSettle::pose;
     const bool tipping = slope == SlopeSettle::tipping;
     update_rest_pose(w, b, settling && b.on_ground && slope == SlopeSettle::pose, settling && !b.on_ground,

@@ -294,6 +294,7 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
     if (!within(p.offset, limits::coordinate)) return Status::out_of_range;
     if (commit) w.planes[i] = p;
   }
+  if (commit) w.tilted_planes = any_tilted_plane(w);
   for (std::uint32_t i = 0; i < bodies; ++i) {
     SnapshotBody<D> r{};
     Body<D>& b = r.body;

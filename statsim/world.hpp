@@ -131,7 +131,9 @@ class WorldCore {
     if (!(len > Scalar(1e-12)) || !detail::finite(len)) return {Status::invalid_plane, 0};
     if (w_.plane_count == w_.max_planes) return {Status::capacity_exceeded, 0};
     w_.planes[w_.plane_count] = Plane<D>{normal / len, offset};
-    return {Status::ok, PlaneId(w_.plane_count++)};
+    ++w_.plane_count;
+    w_.tilted_planes = detail::any_tilted_plane(w_);
+    return {Status::ok, PlaneId(w_.plane_count - 1)};
   }
 
   /// Adds a body. Fails, adding nothing, on bad input (`non_finite`, `zero_quaternion`,
@@ -196,7 +198,7 @@ class WorldCore {
     }
     detail::StepContext ctx;
     ctx.dt = dt;
-    ctx.tilted_planes = detail::any_tilted_plane(w_);
+    ctx.tilted_planes = w_.tilted_planes;
     result.bodies_integrated = detail::integrate(w_, dt);
     detail::update_radii(w_);
     // Before the broad phase, which replaces last step's pairs (it does not read the flags).

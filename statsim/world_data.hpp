@@ -112,6 +112,8 @@ struct WorldData {
   bool sweep_current = false;
   bool grid_layout = false;  ///< the broad phase's block holds the grid (see `entries`)
   bool grid_storage = true;  ///< the block has room for the grid (`World`'s `Phases`)
+  /// Some plane is tilted (`is_tilted_plane`): bodies meet tilted planes with their hulls.
+  bool tilted_planes = false;
   std::uint64_t step_count = 0;
   std::uint64_t energy_clamps = 0;  ///< over the world's life
   std::uint64_t statistical_responses = 0;  ///< over the world's life
