@@ -59,28 +59,16 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
   const Shape<D>& shape = w.shapes[b.shape];
   const WorldDef<D>& def = w.def;
   Vec v = b.linear_velocity - other_velocity;
-  // A contact approaching slower than the restitution threshold is resting, not a collision:
-  // the tables describe collisions, and sampling a fresh spin at every resting step would
-  // keep a body from ever settling. It gets the inelastic particle response instead. A body
-  // that is not settling bounces as the reference did when the table was gathered, down to the
-  // table's threshold; a settling one approaches at |g| dt each step while it rests, so it
-  // keeps the world's. The table's threshold is never taken below 2 |g.n| dt either: a body
-  // sliding or rolling on a plane meets it at |g.n| dt every step, and a sampled response there
-  // would replace the slide's friction and drain a roll's spin at every step.
-  const bool table_threshold =
-      shape.statistical && def.table_restitution_threshold && b.state != MotionState::settling;
-  Scalar threshold = table_threshold ? shape.signature.restitution_threshold : def.restitution_threshold;
-  if (table_threshold) {
-    const Scalar gravity_step = 2 * std::fabs(def.gravity.dot(n)) * ctx.dt;
-    if (threshold < gravity_step) threshold = gravity_step;
-  }
+  const Scalar threshold = restitution_threshold(w, b, n, ctx.dt);
   const bool resting = -v.dot(n) <= threshold;
   // On a slope a body with no rest pose meets the plane with its hull, as a rigid body does, its
   // impacts included (statsim/slope_contact.hpp): how far it tumbles and rolls downhill follows
   // from the strikes of its faces one after the other, each set by the last, which independent
-  // samples of the tables' single-impact responses do not reproduce.
+  // samples of the tables' single-impact responses do not reproduce. A body that rolled through
+  // the step in substeps (`roll_on_slopes`) has had its slope contacts there.
   if (tilted_plane && rolls_on(w, b, n)) {
-    slope_hull_response(shape, b, n, def.gravity, gap, ctx.dt, threshold);
+    if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)))
+      slope_hull_response(shape, b, n, def.gravity, gap, ctx.dt, threshold);
     return;
   }
   if (shape.statistical && tilted_plane && resting && !(ground_contact && b.rest_pose != no_rest_pose)) {
@@ -310,7 +298,8 @@ void support_planes(WorldData<D>& w, StepContext& ctx)
 {
   plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool tilted) {
     if (tilted && rolls_on(w, b, c.normal)) {
-      if (slope_hull_response(w.shapes[b.shape], b, c.normal, w.def.gravity, -c.depth, ctx.dt, no_bounce))
+      if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)) &&
+          slope_hull_response(w.shapes[b.shape], b, c.normal, w.def.gravity, -c.depth, ctx.dt, no_bounce))
         ++ctx.changes;
       return;
     }

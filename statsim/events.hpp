@@ -45,15 +45,15 @@ struct ImpactLog {
   }
 };
 
-/// Fills `log` with the impacts that the impact pass is about to resolve: awake bodies against
+/// Adds to `log` the impacts that the impact pass is about to resolve: awake bodies against
 /// planes, in the pass's order, then the candidate pairs that touch, as `body_contact` finds them
-/// (on copies: the pass finds them again itself). `id_of(slot)` is the id of the body in a slot.
+/// (on copies: the pass finds them again itself). The slope contacts of bodies that rolled in
+/// substeps are not the pass's: `roll_on_slopes` recorded their impacts. `id_of(slot)` is the id
+/// of the body in a slot.
 template <int D, class IdOf>
 void record_impacts(const WorldData<D>& w, ImpactLog<D>& log, IdOf&& id_of)
 {
   using Vec = typename Space<D>::Vec;
-  log.count = 0;
-  log.found = 0;
   if (log.capacity == 0) return;
   const Scalar threshold = w.def.impact_threshold;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
@@ -61,6 +61,7 @@ void record_impacts(const WorldData<D>& w, ImpactLog<D>& log, IdOf&& id_of)
     for (std::uint32_t p = 0; p < w.plane_count; ++p) {
       const Plane<D>& plane = w.planes[p];
       Contact<D> c;
+      if (w.tilted_planes && bit_set(w.rolled, i) && rolls_on(w, b, plane.normal)) continue;
       if (!sphere_plane_contact<D>(b.position, plane_radius(w, b, plane), plane, c)) continue;
       const Scalar approach = -b.linear_velocity.dot(c.normal);
       if (!(approach > threshold)) continue;

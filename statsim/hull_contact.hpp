@@ -339,6 +339,14 @@ bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>
   return is_tilted_plane(w.def.gravity, n, gn);
 }
 
+/// True when body `b` meets a plane of unit normal `n` (towards the body) with its hull
+/// (`slope_hull`) and has no rest pose chosen: its contacts there are `slope_hull_response`'s.
+template <int D>
+bool rolls_on(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  return b.rest_pose == no_rest_pose && slope_hull(w, b, n);
+}
+
 /// The radius a body keeps from a plane of normal `n`: its collision radius, or its hull's
 /// support toward the plane on a slope (`slope_hull`), or, for a settling body with a hull
 /// (`BodyContacts::hulls`), at least its hull's support toward the plane, so that a body resting

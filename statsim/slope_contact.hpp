@@ -17,6 +17,7 @@
 /// No table holds anything for this: the support map and the principal moments are the table's
 /// own. Level ground and walls are not affected.
 
+#include "statsim/events.hpp"
 #include "statsim/hull_contact.hpp"
 #include "statsim/tipping.hpp"
 #include "statsim/world_data.hpp"
@@ -30,14 +31,6 @@ namespace detail {
 
 /// Gauss-Seidel passes over the corners of a slope contact (at most three in 2D, five in 3D).
 constexpr int slope_contact_iterations = 6;
-
-/// True when body `b` meets a plane of unit normal `n` (towards the body) with its hull
-/// (`slope_hull`) and has no rest pose chosen: its contacts there are `slope_hull_response`'s.
-template <int D>
-bool rolls_on(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
-{
-  return b.rest_pose == no_rest_pose && slope_hull(w, b, n);
-}
 
 /// How far a turned corner of a slope contact may stand above the support the body will have at
 /// the end of the step and still take part (`slope_hull_response`), over that support.
@@ -68,16 +61,20 @@ Scalar unit_effective_mass(const Shape<D>& s, const typename Space<D>::Rot& q, c
 
 /// The hull's support point, body frame, m, for the body direction `d` (any length): the
 /// gradient of the support map's support function there, h being homogeneous of degree one,
-/// by differences over a hundredth of a cell (within the cell the interpolation is linear, so
-/// this is the point of the interpolated hull that meets the plane).
+/// by central differences over a hundredth of a cell (within the cell the interpolation is
+/// linear, so this is the point of the interpolated hull that meets the plane). Where `d` is
+/// normal to a face or an edge of that hull the gradient jumps; the central difference takes the
+/// mean of the two sides, so a face gives its centre and an edge its midpoint, symmetric about
+/// the body, where a one-sided difference would pick one corner and the contact's friction would
+/// turn a sliding body about the normal.
 template <int D>
 typename Space<D>::Vec support_point(const ContactView<D>& c, const typename Space<D>::Vec& d)
 {
   using Vec = typename Space<D>::Vec;
   const Scalar eps = Scalar(0.02) / Scalar(c.support_size - 1) * d.norm();
-  const Scalar h0 = support_along(c, d);
   Vec q;
-  for (int j = 0; j < D; ++j) q[j] = (support_along(c, Vec(d + Vec::Unit(j) * eps)) - h0) / eps;
+  for (int j = 0; j < D; ++j)
+    q[j] = (support_along(c, Vec(d + Vec::Unit(j) * eps)) - support_along(c, Vec(d - Vec::Unit(j) * eps))) / (2 * eps);
   return q;
 }
 
@@ -169,6 +166,94 @@ bool slope_hull_response(const Shape<D>& s, Body<D>& b, const typename Space<D>:
       apply(r[k], Vec(total - pt[k]));
       pt[k] = total;
     }
+  return true;
+}
+
+/// The approach speed below which a contact of body `b` along unit normal `n` (towards it) is
+/// resting, not a collision, in a step of `dt` seconds, m/s.
+template <int D>
+Scalar restitution_threshold(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n, Scalar dt)
+{
+  // A resting contact gets the inelastic particle response: the tables describe collisions, and
+  // sampling a fresh spin at every resting step would keep a body from ever settling. A body
+  // that is not settling bounces as the reference did when the table was gathered, down to the
+  // table's threshold; a settling one approaches at |g| dt each step while it rests, so it keeps
+  // the world's. The table's threshold is never taken below 2 |g.n| dt either: a body sliding or
+  // rolling on a plane meets it at |g.n| dt every step, and a sampled response there would
+  // replace the slide's friction and drain a roll's spin at every step.
+  const Shape<D>& shape = w.shapes[b.shape];
+  const WorldDef<D>& def = w.def;
+  const bool table_threshold = shape.statistical && def.table_restitution_threshold && b.state != MotionState::settling;
+  Scalar threshold = table_threshold ? shape.signature.restitution_threshold : def.restitution_threshold;
+  if (table_threshold) {
+    const Scalar gravity_step = 2 * std::fabs(def.gravity.dot(n)) * dt;
+    if (threshold < gravity_step) threshold = gravity_step;
+  }
+  return threshold;
+}
+
+/// Longest time step of a slope contact, s: the step of the reference runs the tables are
+/// gathered from. A hull contact is a rigid body's contact, and like the reference's it follows a
+/// roll only at such steps: a corner that strikes within a long step strikes at the wrong time
+/// and place, and the body loses to the impulses what it would have kept (tools/stress/README.md,
+/// "Substeps on slopes", gives the distances rolled against the step).
+constexpr Scalar slope_contact_step = Scalar(0.001);
+
+/// Moves awake body `i` through a step of `dt` seconds in substeps of at most
+/// `slope_contact_step` when it touched something in the last step and `rolls_on` a slope that it
+/// is within `slope_reach` of: gravity, damping, the contacts with every
+/// such slope (`slope_hull_response`, the body kept out of the plane) and the move, in each
+/// substep. Its impacts with those slopes faster than `WorldDef::impact_threshold` go to `log`
+/// (each substep's, with the approach speed of the centre, as `record_impacts` measures it).
+/// Marks the body in `WorldData::rolled`: the step's contact passes leave its slope contacts
+/// alone. Returns false, changing nothing, for any other body.
+template <int D, class IdOf>
+bool roll_on_slopes(WorldData<D>& w, std::uint32_t i, Scalar dt, ImpactLog<D>& log, IdOf&& id_of)
+{
+  using Vec = typename Space<D>::Vec;
+  Body<D>& b = w.bodies[i];
+  const Shape<D>& shape = w.shapes[b.shape];
+  const WorldDef<D>& def = w.def;
+  const Scalar reach = shape.bounding_radius * slope_reach;
+  // A body arriving at a slope meets it in the step's impact pass; one that touched last step and
+  // is still within reach rolls on it.
+  bool near = false;
+  for (std::uint32_t p = 0; p < w.plane_count && b.touching && !near; ++p) {
+    const Plane<D>& plane = w.planes[p];
+    if (!rolls_on(w, b, plane.normal)) continue;
+    // The hull's support never exceeds the bounding radius: read it only when that can reach.
+    const Scalar distance = plane.normal.dot(b.position) - plane.offset;
+    near = distance - shape.bounding_radius < reach && distance - hull_radius(w, b, plane.normal) < reach;
+  }
+  if (!near) return false;
+  const int steps = int(std::ceil(dt / slope_contact_step));  // dt <= limits::time_step
+  const Scalar h = dt / Scalar(steps);
+  const Scalar lin_damp = Scalar(1) / (1 + h * def.linear_damping);
+  const Scalar ang_damp = Scalar(1) / (1 + h * def.angular_damping);
+  for (int k = 0; k < steps; ++k) {
+    b.linear_velocity = (b.linear_velocity + def.gravity * h) * lin_damp;
+    b.angular_velocity = b.angular_velocity * ang_damp;
+    for (std::uint32_t p = 0; p < w.plane_count; ++p) {
+      const Plane<D>& plane = w.planes[p];
+      if (!rolls_on(w, b, plane.normal)) continue;
+      Scalar gap = plane.normal.dot(b.position) - plane.offset - hull_radius(w, b, plane.normal);
+      if (gap < 0) {
+        b.position -= plane.normal * gap;
+        gap = 0;
+      }
+      if (!(gap < reach)) continue;
+      const Scalar approach = -b.linear_velocity.dot(plane.normal);
+      const Scalar threshold = restitution_threshold(w, b, plane.normal, h);
+      if (!slope_hull_response(shape, b, plane.normal, def.gravity, gap, h, threshold)) continue;
+      if (log.capacity > 0 && approach > def.impact_threshold) {
+        const Vec foot = b.position - plane.normal * (plane.normal.dot(b.position) - plane.offset);
+        log.add(Impact<D>{id_of(i), no_body, PlaneId(p), foot, plane.normal, approach});
+      }
+    }
+    b.position += b.linear_velocity * h;
+    b.orientation = integrate(b.orientation, b.angular_velocity, h);
+  }
+  set_bit(w.rolled, i);
   return true;
 }
 

@@ -8,7 +8,8 @@
 ///
 /// A step, in order (each phase is a function of `detail`, in the file named):
 ///  1. integrate awake bodies (semi-implicit Euler; orientation without trigonometry;
-///     world_data.hpp) and set the statistical bodies' collision radii (rest_and_sleep.hpp);
+///     world_data.hpp; a body rolling on a slope in substeps with its slope contacts,
+///     slope_contact.hpp) and set the statistical bodies' collision radii (rest_and_sleep.hpp);
 ///  2. broad phase (hashed grid or sweep-and-prune) on the bounding radius (find_pairs.hpp);
 ///  3. impact pass: body-plane then body-body contacts get the bodies' response (the statistical
 ///     response for statistical bodies, the particle response for plain spheres); planes push
@@ -199,12 +200,18 @@ class WorldCore {
     detail::StepContext ctx;
     ctx.dt = dt;
     ctx.tilted_planes = w_.tilted_planes;
-    result.bodies_integrated = detail::integrate(w_, dt);
+    const auto id = [this](std::uint32_t slot) { return id_of(slot); };
+    impacts_.count = 0;
+    impacts_.found = 0;
+    if (w_.tilted_planes)
+      for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) w_.rolled[k] = 0;
+    result.bodies_integrated = detail::integrate(
+        w_, dt, [&](std::uint32_t i) { return w_.tilted_planes && detail::roll_on_slopes(w_, i, dt, impacts_, id); });
     detail::update_radii(w_);
     // Before the broad phase, which replaces last step's pairs (it does not read the flags).
     detail::forget_contacts(w_);
     detail::find_pairs(w_, result);
-    detail::record_impacts(w_, impacts_, [this](std::uint32_t slot) { return id_of(slot); });
+    detail::record_impacts(w_, impacts_, id);
     result.impacts_found = impacts_.found;
     if (impacts_.found > impacts_.count) {
       result.impacts_dropped = impacts_.found - impacts_.count;
@@ -326,6 +333,7 @@ class WorldCore {
     Shape<D>* shapes;
     std::uint32_t* awake;
     std::uint32_t* flagged;
+    std::uint32_t* rolled;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
     Impact<D>* impacts;
     std::uint32_t max_impacts;
@@ -349,6 +357,7 @@ class WorldCore {
                           : detail::SpatialHash<D>{nullptr, nullptr, 1},
            s.awake,
            s.flagged,
+           s.rolled,
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
@@ -404,7 +413,8 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                                                      StorageBase::pair_store.data(), StorageBase::plane_store.data(),
                                                      StorageBase::shape_store.data(),
                                                      StorageBase::awake_store.data(),
-                                                     StorageBase::flagged_store.data(), MaxBodies, MaxPairs, MaxPlanes,
+                                                     StorageBase::flagged_store.data(),
+                                                     StorageBase::rolled_store.data(), MaxBodies, MaxPairs, MaxPlanes,
                                                      MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
                                                      StorageBase::generation_store.data(),
                                                      StorageBase::free_store.data(), StorageBase::grid},

@@ -51,6 +51,7 @@ inline void set_bit(std::uint32_t* words, std::uint32_t i)
 {
   words[i / 32] |= std::uint32_t(1) << (i % 32);
 }
+inline bool bit_set(const std::uint32_t* words, std::uint32_t i) { return (words[i / 32] >> (i % 32)) & 1u; }
 inline void clear_bit(std::uint32_t* words, std::uint32_t i)
 {
   words[i / 32] &= ~(std::uint32_t(1) << (i % 32));
@@ -96,6 +97,9 @@ struct WorldData {
   /// may still be set: the next step clears their flags with the awake bodies' and those of the
   /// last step's touching pairs (the only sleepers the passes mark).
   std::uint32_t* flagged;
+  /// Bit set of the bodies that this step moved in substeps on a slope (`roll_on_slopes`): the
+  /// contact passes leave their slope contacts alone. Scratch of the step, not part of the state.
+  std::uint32_t* rolled;
   std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   std::uint32_t body_count = 0, pair_count = 0, plane_count = 0, shape_count = 0;
   /// Bodies that have a sweep entry: sweep-and-prune adds the entries of newer bodies when it
@@ -192,10 +196,11 @@ bool sleeps_from_anchor(const WorldData<D>& w, const Body<D>& b)
 }
 
 /// Semi-implicit Euler for awake bodies: gravity and damping change the velocity, which then
-/// moves the body; orientation without trigonometry (`detail::integrate`). Returns the number of
+/// moves the body; orientation without trigonometry (`detail::integrate`). `own(i)` may move
+/// body i through the step itself (`roll_on_slopes`) and return true. Returns the number of
 /// bodies integrated.
-template <int D>
-std::uint32_t integrate(WorldData<D>& w, Scalar dt)
+template <int D, class Own>
+std::uint32_t integrate(WorldData<D>& w, Scalar dt, Own&& own)
 {
   using Vec = typename Space<D>::Vec;
   const Vec dv = w.def.gravity * dt;
@@ -208,11 +213,12 @@ std::uint32_t integrate(WorldData<D>& w, Scalar dt)
     // The sleep test may measure from where the body's slow time began (`sleeps_from_anchor`):
     // the centre is kept there while the clock runs.
     if (b.slow_time == 0 || !hulls || !sleeps_from_anchor(w, b)) b.step_start = b.position;
+    ++count;
+    if (own(i)) return;
     b.linear_velocity = (b.linear_velocity + dv) * lin_damp;
     b.angular_velocity = b.angular_velocity * ang_damp;
     b.position += b.linear_velocity * dt;
     b.orientation = integrate(b.orientation, b.angular_velocity, dt);
-    ++count;
   });
   return count;
 }
