@@ -214,7 +214,11 @@ Status check_snapshot_body(const WorldData<D>& w, const SnapshotBody<D>& r, cons
   if (s != Status::ok) return s;
   if (!finite(b.radius) || !finite(b.inv_mass) || !finite(b.slow_time) || !finite(b.rest_blend))
     return Status::non_finite;
-  if (!(b.radius > 0) || b.radius > limits::max_radius) return Status::invalid_radius;
+  // A plain sphere keeps its shape's radius; a statistical body's comes from its table, whose
+  // shapes the world's limits bound. A smaller one (a tiny positive float) would overflow the
+  // contact arithmetic to infinity.
+  if (!(b.radius >= limits::min_radius) || b.radius > limits::max_radius) return Status::invalid_radius;
+  if (!shape.statistical && b.radius != shape.radius) return Status::invalid_radius;
   if (b.inv_mass < Scalar(1) / limits::max_mass || b.inv_mass > Scalar(1) / limits::min_mass) return Status::invalid_mass;
   if (b.slow_time < 0 || b.rest_blend < 0 || b.rest_blend > 1) return Status::out_of_range;
   if (b.rest_pose != no_rest_pose && (!shape.statistical || b.rest_pose >= shape.signature.rest.count))

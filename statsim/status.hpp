@@ -16,7 +16,7 @@ enum class [[nodiscard]] Status : std::uint8_t {
   non_unit_quaternion,   ///< orientation length differed from 1 by more than 1e-3
   invalid_time_step,     ///< dt was not finite and positive, or above `limits::time_step` (1 s)
   invalid_plane,         ///< plane normal was zero or not finite, or offset not finite
-  invalid_radius,        ///< a radius was not positive, or bounding radius < collision radius
+  invalid_radius,        ///< a radius not positive (in a snapshot: below limits::min_radius, or not a plain sphere's own), or bounding < collision radius
   invalid_mass,          ///< mass was not positive (or 0 with a shape that records none)
   invalid_material,      ///< restitution outside [0, 1] or friction negative
   invalid_shape,         ///< shape id does not name a shape of this world (another world's, or past the end), or a malformed signature

@@ -272,11 +272,21 @@ TEST_CASE("snapshot: refused loads leave the world as it was")
       Status expected;
     };
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    std::uint32_t nan_bits, two_bits, far_bits;
-    const float two = 2, far = 2e6f;
+    std::uint32_t nan_bits, two_bits, far_bits, tiny_bits, wider_bits;
+    const float two = 2, far = 2e6f, tiny = 1e-30f, wider = 0.09f;
     std::memcpy(&nan_bits, &nan, 4);
     std::memcpy(&two_bits, &two, 4);
     std::memcpy(&far_bits, &far, 4);
+    std::memcpy(&tiny_bits, &tiny, 4);
+    std::memcpy(&wider_bits, &wider, 4);
+    // The collision radius follows the flags byte, 2 + 2 + 1 + 1 bytes of generation, shape,
+    // state and pose, the 8-byte random state, the orientation and three vectors; bodies that
+    // keep their step start (flag 16) have it after the four scalars. The first ball (shape 1):
+    const auto radius_at = [](std::size_t at) { return at + 15 + 16 + 3 * 12; };
+    std::size_t ball = body;
+    while (ball + 80 < good.size() && (get32(good, ball + 3) & 0xffffu) != 1)
+      ball = radius_at(ball) + 16 + ((good[ball] & 16) ? 12 : 0);
+    REQUIRE(ball + 80 < good.size());
     const Edit edits[] = {
         {position, nan_bits, Status::non_finite},
         {position, far_bits, Status::out_of_range},
@@ -288,6 +298,8 @@ TEST_CASE("snapshot: refused loads leave the world as it was")
         {order, entries, Status::invalid_snapshot},                 // a slot past the end
         {20, 8, Status::ok},                                        // more planes than written
         {def_offset - 4, 0x7f800000u, Status::invalid_snapshot},    // widest: no shape's diameter
+        {radius_at(body), tiny_bits, Status::invalid_radius},       // below limits::min_radius
+        {radius_at(ball), wider_bits, Status::invalid_radius},      // a ball of 0.08 m at 0.09 m
     };
     for (const Edit& e : edits) {
       Bytes b = good;
