@@ -52,6 +52,22 @@
 #include <cstdlib>
 #endif
 
+/// 1: a world can run parts of its step on worker threads that the program lends it
+/// (`WorldDef::workers`, statsim/README.md "Workers"). 0: that code is left out, and a world
+/// refuses `Workers::count` above 1 with `Status::invalid_parameter`. Default: 1 on an operating
+/// system (Unix, macOS, Windows), 0 elsewhere (bare metal, WebAssembly), where it would be code
+/// that nothing calls.
+#ifndef STATSIM_WORKERS
+#if (defined(__unix__) || defined(__APPLE__) || defined(_WIN32)) && !defined(__EMSCRIPTEN__)
+#define STATSIM_WORKERS 1
+#else
+#define STATSIM_WORKERS 0
+#endif
+#endif
+#if STATSIM_WORKERS != 0 && STATSIM_WORKERS != 1
+#error "STATSIM_WORKERS must be 0 or 1"
+#endif
+
 /// Version of the layout of generated signature tables. A table generated for another version
 /// fails to compile against this runtime (the tables static_assert on it).
 #define STATSIM_TABLE_FORMAT_VERSION 2

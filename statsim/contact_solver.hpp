@@ -26,6 +26,7 @@
 #include "statsim/hull_contact.hpp"
 #include "statsim/slope_contact.hpp"
 #include "statsim/tipping.hpp"
+#include "statsim/workers.hpp"
 #include "statsim/world_data.hpp"
 
 #include <algorithm>
@@ -250,12 +251,14 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
 
 /// The shared loop over body-body contacts among the first `count` candidate pairs (grown by
 /// `contact_slop` of their reach when `grown`; the impact pass, not grown, finds each pair's
-/// hull contact afresh). For each touching pair it calls `resolve(a, b, contact, slop, reach)`,
+/// hull contact afresh unless `search_witnesses_first` has). For each touching pair it calls
+/// `resolve(a, b, contact, slop, reach)`,
 /// which returns false when neither body can move, and else marks both touching. With
 /// `compact`, touching pairs move to the front of the buffer, in their order. Returns the
 /// number of touching pairs.
 template <int D, class Resolve>
-std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bool compact, Resolve&& resolve)
+std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bool compact, Resolve&& resolve,
+                            bool fresh = true)
 {
   std::uint32_t touching = 0;
   for (std::uint32_t k = 0; k < count; ++k) {
@@ -263,7 +266,7 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
     Body<D>& b = w.bodies[w.pairs[k].b];
     Contact<D> c;
     Scalar reach, slop;
-    if (!body_contact(w, a, b, w.pairs[k], !grown, grown ? contact_slop : Scalar(0), c, reach, slop)) continue;
+    if (!body_contact(w, a, b, w.pairs[k], fresh && !grown, grown ? contact_slop : Scalar(0), c, reach, slop)) continue;
     if (compact) std::swap(w.pairs[touching], w.pairs[k]);
     ++touching;
     if (!resolve(a, b, c, slop, reach)) continue;
@@ -324,6 +327,7 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
                                         w.shapes[b.shape].material, def.restitution_threshold))
       ++ctx.changes;
   });
+  const bool searched = search_witnesses_first(w);
   ctx.touching = pair_contacts(w, w.pair_count, false, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c,
                                                                  Scalar slop, Scalar reach) {
     const Vec& n = c.normal;
@@ -344,7 +348,7 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
     else if (particle_pair(w, a, b, n, ima, imb, def.restitution_threshold)) ++ctx.changes;
     if (!def.shock_propagation) correct_overlap(w, ctx, a, b, c, slop, reach, ima, imb, ims);
     return true;
-  });
+  }, !searched);
   return plane_count + ctx.touching;
 }
 

@@ -91,39 +91,39 @@ void measure_drift(WorldData<D>& w)
   q.drift = lost ? std::numeric_limits<Scalar>::quiet_NaN() : drift;
 }
 
-/// Pairs from the grid of cells one widest bounding diameter wide: each awake body looks at the
-/// bodies in the 3^D cells around its own. Returns how many were found (also those that did not
-/// fit the buffer).
+/// What the grid's pair search of one step reads besides the grid: fixed once the grid is built.
 template <int D>
-std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
+struct GridSearch {
+  WorldData<D>* w;
+  Scalar half_cell;  ///< the widest bounding radius, in cells
+  Scalar common;     ///< `WorldData::common_bound`
+  bool regular;      ///< no body in a clamped cell (else every neighbouring cell is visited)
+};
+
+/// The cell of body i, as `SpatialHash::build` sorted it.
+template <int D>
+void grid_cell(const WorldData<D>& w, std::uint32_t i, std::int32_t* c)
 {
-  SpatialHash<D>& grid = w.grid;
+  for (int k = 0; k < 3; ++k) c[k] = k < D ? w.grid.cell_of(w.bodies[i].position[k], w.grid.inv_cell) : 0;
+}
+
+/// The pairs that awake bodies of the bit words [first_word, end_word) find in the 3^D cells
+/// around their own, in body order, written to `out` while fewer than `capacity`; `found` counts
+/// them all and `examined` the records read.
+template <int D>
+void search_grid(const GridSearch<D>& s, std::uint32_t first_word, std::uint32_t end_word, Pair* out,
+                 std::uint32_t capacity, std::uint32_t& found, std::uint32_t& examined)
+{
+  const WorldData<D>& w = *s.w;
+  const SpatialHash<D>& grid = w.grid;
   const Scalar widest = w.widest;
-  grid.inv_cell = Scalar(1) / widest;
-  // Bodies far out (or not finite) share clamped cells: then every neighbouring cell is visited.
-  bool regular = true;
-  const auto cell = [&w, &grid, &regular](std::uint32_t i, std::int32_t* c) {
-    for (int k = 0; k < 3; ++k) {
-      c[k] = k < D ? grid.cell_of(w.bodies[i].position[k], grid.inv_cell) : 0;
-      regular = regular && c[k] > -100000000 && c[k] < 100000000;
-    }
-  };
-  const auto item = [&w](std::uint32_t i) {
-    const Body<D>& b = w.bodies[i];
-    return GridItem<D>{b.position, b.state != MotionState::asleep ? i : i + asleep_key};
-  };
-  grid.build(w.body_count, cell, item);
-  made_records(w, true);
-  result.broad_phase_bodies += w.body_count;
-  std::uint32_t found = 0, examined = 0;
+  const Scalar common = s.common;
   constexpr int neighbours = D == 3 ? 27 : 9;
-  const Scalar half_cell = Scalar(0.5) * widest * grid.inv_cell;  // the widest bounding radius, in cells
-  const Scalar common = w.common_bound;
-  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
+  const auto search = [&](std::uint32_t i) {
     const Body<D>& bi = w.bodies[i];
     const Scalar bound_i = common > 0 ? common : w.shapes[bi.shape].bounding_radius;
     std::int32_t c[3];
-    cell(i, c);
+    grid_cell(w, i, c);
     // Where the body is in its cell, in cells: a neighbouring cell holds a body it can touch only
     // if the cell comes within the body's reach (its bounding radius and the widest one). Cells
     // beyond it are skipped, with a margin for the rounding of x / cell.
@@ -135,7 +135,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
       high[k] = 1 - low[k];
       margin += std::fabs(u) * Scalar(1e-6);
     }
-    const Scalar r = bound_i * grid.inv_cell + half_cell + margin;
+    const Scalar r = bound_i * grid.inv_cell + s.half_cell + margin;
     const Scalar r2 = r * r;
     const Scalar reach_max = bound_i + Scalar(0.5) * widest;
     const Scalar reach_max2 = reach_max * reach_max;
@@ -154,7 +154,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
         const Scalar gap = d[k] < 0 ? low[k] : (d[k] > 0 ? high[k] : Scalar(0));
         gap2 += gap * gap;
       }
-      visit[n] = !regular || !(gap2 > r2);
+      visit[n] = !s.regular || !(gap2 > r2);
       const std::uint64_t bit = std::uint64_t(1) << (bucket[n] & 63u);
       if (bucket_bits & bit) {
         for (int k = 0; k < n; ++k)
@@ -182,11 +182,147 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
         const std::uint32_t j = it->key & ~asleep_key;
         const Scalar reach = bound_i + (common > 0 ? common : w.shapes[w.bodies[j].shape].bounding_radius);
         if (d2 > reach * reach) continue;
-        if (found < w.max_pairs) w.pairs[found] = Pair{i < j ? i : j, i < j ? j : i};
+        if (found < capacity) out[found] = Pair{i < j ? i : j, i < j ? j : i};
         ++found;
       }
     }
-  });
+  };
+  for (std::uint32_t k = first_word; k < end_word; ++k)
+    for (std::uint32_t bits = w.awake[k]; bits != 0; bits &= bits - 1) search(k * 32 + lowest_bit(bits));
+}
+
+/// The number of bits set in x.
+inline std::uint32_t bit_count(std::uint32_t x)
+{
+  x = x - ((x >> 1) & 0x55555555u);
+  x = (x & 0x33333333u) + ((x >> 2) & 0x33333333u);
+  return (((x + (x >> 4)) & 0x0f0f0f0fu) * 0x01010101u) >> 24;
+}
+
+/// The fewest awake bodies worth a part of the grid's search of their own (a few tenths of a
+/// millisecond of it), and the parts per worker.
+constexpr std::uint32_t awake_per_part = 512;
+constexpr std::uint32_t grid_parts_per_worker = 4;
+
+/// One part of the grid's pair search on a worker: a run of awake bodies and its share of the
+/// pair buffer.
+struct GridPart {
+  std::uint32_t first_word, end_word;  ///< bit words of `WorldData::awake`
+  std::uint32_t offset, capacity;      ///< its share: pairs [offset, offset + capacity)
+  std::uint32_t found, examined;
+};
+
+template <int D>
+struct GridTask {
+  const GridSearch<D>* search;
+  GridPart* parts;
+};
+
+template <int D>
+void run_grid_parts(std::uint32_t begin, std::uint32_t end, void* context)
+{
+  const GridTask<D>& t = *static_cast<const GridTask<D>*>(context);
+  for (std::uint32_t p = begin; p < end; ++p) {
+    GridPart& part = t.parts[p];
+    search_grid(*t.search, part.first_word, part.end_word, t.search->w->pairs + part.offset, part.capacity, part.found,
+                part.examined);
+  }
+}
+
+/// The search on `Workers::count` workers. The awake bodies are cut into runs of about equal
+/// numbers, and each run gets a share of the pair buffer in proportion. Joined in order, the runs'
+/// pairs are those of one search over all bodies; when a run found more pairs than its share
+/// holds, its pairs are incomplete, and the search runs again on the calling thread. Returns
+/// false when it did not run (too few awake bodies to split); else `found` and `examined`.
+template <int D>
+bool search_grid_parts(const GridSearch<D>& s, std::uint32_t& found, std::uint32_t& examined)
+{
+  WorldData<D>& w = *s.w;
+  const Workers& workers = w.def.workers;
+  const std::uint32_t words = bit_words(w.body_count);
+  // More parts than workers: the work per body varies (a body in a pile reads many more records
+  // than one falling alone), and a worker done early takes the next part.
+  std::uint32_t parts = workers.count * grid_parts_per_worker;
+  if (parts > limits::max_workers) parts = limits::max_workers;
+  if (parts > words) parts = words;
+  // Parts of at least `awake_per_part` bodies: fewer would cost more to hand out than they save.
+  if (w.awake_count / awake_per_part < parts) parts = w.awake_count / awake_per_part;
+  if (parts < 2) return false;
+  GridPart part[limits::max_workers];
+  // Cut where the running count of awake bodies passes p / parts of them: one pass over the words.
+  std::uint32_t p = 0, seen = 0;
+  part[0].first_word = 0;
+  for (std::uint32_t k = 0; k < words && p + 1 < parts; ++k) {
+    seen += bit_count(w.awake[k]);
+    if (std::uint64_t(seen) * parts >= std::uint64_t(p + 1) * w.awake_count) {
+      part[p].end_word = k + 1;
+      part[++p].first_word = k + 1;
+    }
+  }
+  part[p].end_word = words;
+  parts = p + 1;
+  // Shares in proportion to the awake bodies up to the end of each run.
+  std::uint32_t offset = 0, before = 0;
+  for (std::uint32_t q = 0; q < parts; ++q) {
+    for (std::uint32_t k = part[q].first_word; k < part[q].end_word; ++k) before += bit_count(w.awake[k]);
+    const std::uint32_t end = q + 1 == parts ? w.max_pairs
+                                             : std::uint32_t(std::uint64_t(w.max_pairs) * before / w.awake_count);
+    part[q].offset = offset;
+    part[q].capacity = end - offset;
+    part[q].found = part[q].examined = 0;
+    offset = end;
+  }
+  GridTask<D> task{&s, part};
+  run_on_workers(w, parts, 1, &run_grid_parts<D>, &task);
+  found = examined = 0;
+  bool short_share = false;
+  for (std::uint32_t q = 0; q < parts; ++q) {
+    examined += part[q].examined;
+    short_share = short_share || part[q].found > part[q].capacity;
+  }
+  if (short_share) {
+    examined = 0;
+    search_grid(s, 0, words, w.pairs, w.max_pairs, found, examined);
+    return true;
+  }
+  for (std::uint32_t q = 0; q < parts; ++q) {
+    // Moved down to the end of the pairs before: the gap only opens forward, so a copy from the
+    // front never overwrites a pair it has yet to read.
+    for (std::uint32_t k = 0; k < part[q].found; ++k) w.pairs[found + k] = w.pairs[part[q].offset + k];
+    found += part[q].found;
+  }
+  return true;
+}
+
+/// Pairs from the grid of cells one widest bounding diameter wide: each awake body looks at the
+/// bodies in the 3^D cells around its own. Returns how many were found (also those that did not
+/// fit the buffer).
+template <int D>
+std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
+{
+  SpatialHash<D>& grid = w.grid;
+  const Scalar widest = w.widest;
+  grid.inv_cell = Scalar(1) / widest;
+  // Bodies far out (or not finite) share clamped cells: then every neighbouring cell is visited.
+  bool regular = true;
+  const auto cell = [&w, &regular](std::uint32_t i, std::int32_t* c) {
+    grid_cell(w, i, c);
+    for (int k = 0; k < 3; ++k) regular = regular && c[k] > -100000000 && c[k] < 100000000;
+  };
+  const auto item = [&w](std::uint32_t i) {
+    const Body<D>& b = w.bodies[i];
+    return GridItem<D>{b.position, b.state != MotionState::asleep ? i : i + asleep_key};
+  };
+  grid.build(w.body_count, cell, item);
+  made_records(w, true);
+  result.broad_phase_bodies += w.body_count;
+  const GridSearch<D> s{&w, Scalar(0.5) * widest * grid.inv_cell, w.common_bound, regular};
+  std::uint32_t found = 0, examined = 0;
+#if STATSIM_WORKERS
+  // (The parts' records are on the stack of `search_grid_parts`, called only with workers.)
+  if (w.def.workers.count < 2 || !search_grid_parts(s, found, examined))
+#endif
+    search_grid(s, 0, bit_words(w.body_count), w.pairs, w.max_pairs, found, examined);
   result.pairs_examined += examined;
   return found;
 }

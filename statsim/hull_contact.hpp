@@ -261,6 +261,33 @@ bool hull_pair(const WorldData<D>& w, const Body<D>& a, const Body<D>& b)
          (sa.statistical || sb.statistical);
 }
 
+/// The unit line of centres `e` and the distance of two bodies `d` apart (b - a); false when
+/// their bounding spheres are apart.
+template <int D>
+bool centre_line(const Shape<D>& sa, const Shape<D>& sb, const typename Space<D>::Vec& d, Scalar& dist,
+                 typename Space<D>::Vec& e)
+{
+  using Vec = typename Space<D>::Vec;
+  const Scalar dist2 = d.squaredNorm();
+  const Scalar bound = sa.bounding_radius + sb.bounding_radius;
+  if (!(dist2 < bound * bound)) return false;
+  dist = std::sqrt(dist2);
+  // Coincident centres: any direction is as good; up keeps it defined and deterministic.
+  e = dist > bound * Scalar(1e-6) ? Vec(d / dist) : Vec(Vec::Unit(Space<D>::up_axis));
+  return true;
+}
+
+/// The impact pass's search of a pair's hull candidate (`find_hull_witness`), into `pair.witness`.
+template <int D>
+void search_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, const Body<D>& b,
+                    const typename Space<D>::Vec& e, Scalar dist, Pair& pair)
+{
+  const Scalar pa = sa.statistical ? sa.largest_packing : Scalar(1);
+  const Scalar pb = sb.statistical ? sb.largest_packing : Scalar(1);
+  pair.witness =
+      find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb, pair_packing(sa, sb, a.shape == b.shape, e));
+}
+
 /// Whether the pair touches and how: at their collision spheres, or (`BodyContacts::hulls`,
 /// both shapes with a hull) along a hull candidate, searched afresh when `fresh` (the impact
 /// pass) and else the one the impact pass found. `slop_fraction`: spheres grown by this fraction
@@ -279,21 +306,11 @@ bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, boo
     return sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c);
   }
   const Vec d = b.position - a.position;
-  const Scalar dist2 = d.squaredNorm();
-  const Scalar bound = sa.bounding_radius + sb.bounding_radius;
-  if (!(dist2 < bound * bound)) return false;
-  const Scalar dist = std::sqrt(dist2);
-  // Coincident centres: any direction is as good; up keeps it defined and deterministic.
-  const Vec e = dist > bound * Scalar(1e-6) ? Vec(d / dist) : Vec(Vec::Unit(Space<D>::up_axis));
-  if (fresh) {
-    const Scalar pa = sa.statistical ? sa.largest_packing : Scalar(1);
-    const Scalar pb = sb.statistical ? sb.largest_packing : Scalar(1);
-    pair.witness = find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb,
-                                     pair_packing(sa, sb, a.shape == b.shape, e));
-    if (pair.witness == no_witness) return false;
-  } else if (pair.witness == no_witness) {
-    return false;
-  }
+  Scalar dist;
+  Vec e;
+  if (!centre_line(sa, sb, d, dist, e)) return false;
+  if (fresh) search_witness(sa, a, sb, b, e, dist, pair);
+  if (pair.witness == no_witness) return false;
   const HullCandidate<D> h = hull_candidate(sa, a, sb, b, e, pair.witness);
   reach = (pair.witness == 0 ? pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
   slop = reach * slop_fraction;
@@ -302,25 +319,6 @@ bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, boo
   c.normal = h.normal;
   c.depth = depth;
   return true;
-}
-
-/// True when the plane of unit normal `n` is tilted: it carries weight (n.g < 0) and gravity
-/// `g` pulls along it (a part that is not exactly zero). Writes g.n to `gn`.
-template <class Vec>
-bool is_tilted_plane(const Vec& g, const Vec& n, Scalar& gn)
-{
-  gn = g.dot(n);
-  return gn < 0 && (g - n * gn).squaredNorm() > 0;
-}
-
-/// True when some plane is tilted (`WorldData::tilted_planes`, set as planes are added).
-template <int D>
-bool any_tilted_plane(const WorldData<D>& w)
-{
-  Scalar gn;
-  for (std::uint32_t p = 0; p < w.plane_count; ++p)
-    if (is_tilted_plane(w.def.gravity, w.planes[p].normal, gn)) return true;
-  return false;
 }
 
 /// True when body `b` meets the plane of unit normal `n` with its hull, as a rigid body would

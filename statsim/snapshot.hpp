@@ -275,6 +275,7 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
   }
   if (!widest_known) return Status::invalid_snapshot;
   if (commit) {
+    def.workers = w.def.workers;  // the loading world's threads, not the saving one's
     w.def = def;
     w.step_count = steps;
     w.energy_clamps = clamps;

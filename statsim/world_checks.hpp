@@ -30,7 +30,9 @@ Status check_world_def(const WorldDef<D>& d)
       !(d.overlap_correction > 0) || d.overlap_correction > 1 || !(d.rest_blend_time > 0) ||
       !(d.rest_turn_time > 0) || d.ground_cosine < 0 || d.ground_cosine > 1 || d.rest_snap_cosine < 0 ||
       d.rest_snap_cosine > 1 || d.spin_ratio_speed_floor < 0 || d.sweep_axis < 0 || d.sweep_axis >= D ||
-      !within(d.gravity, limits::gravity) || d.rest_turn_time < Scalar(1e-4) || d.impact_threshold < 0)
+      !within(d.gravity, limits::gravity) || d.rest_turn_time < Scalar(1e-4) || d.impact_threshold < 0 ||
+      d.workers.count < 1 || d.workers.count > limits::max_workers ||
+      (d.workers.count > 1 && (!STATSIM_WORKERS || d.workers.enqueue == nullptr || d.workers.finish == nullptr)))
     return Status::invalid_parameter;
   return Status::ok;
 }

@@ -150,6 +150,43 @@ struct StepContext {
   bool tilted_planes = false;       ///< `any_tilted_plane`: some contact may be on a slope
 };
 
+/// True when the plane of unit normal `n` is tilted: it carries weight (n.g < 0) and gravity
+/// `g` pulls along it (a part that is not exactly zero). Writes g.n to `gn`.
+template <class Vec>
+bool is_tilted_plane(const Vec& g, const Vec& n, Scalar& gn)
+{
+  gn = g.dot(n);
+  return gn < 0 && (g - n * gn).squaredNorm() > 0;
+}
+
+/// True when some plane is tilted (`WorldData::tilted_planes`, set as planes are added).
+template <int D>
+bool any_tilted_plane(const WorldData<D>& w)
+{
+  Scalar gn;
+  for (std::uint32_t p = 0; p < w.plane_count; ++p)
+    if (is_tilted_plane(w.def.gravity, w.planes[p].normal, gn)) return true;
+  return false;
+}
+
+/// Runs `task(begin, end, context)` over the items [0, count): in ranges of at least `min_range`
+/// items on the world's workers, about four per worker (items differ in cost, and a worker done
+/// early takes another range), or at once on the calling thread when there are no workers or too
+/// few items to share (handing out a task costs a thread's wake-up, tens of microseconds).
+template <int D>
+void run_on_workers(const WorldData<D>& w, std::uint32_t count, std::uint32_t min_range, TaskCallback* task,
+                    void* context)
+{
+  const Workers& k = w.def.workers;
+  const std::uint32_t range = std::uint32_t((std::uint64_t(count) + 4 * k.count - 1) / (4 * k.count));
+  if (k.count < 2 || count < 2 * min_range) {
+    task(0, count, context);
+    return;
+  }
+  void* handle = k.enqueue(task, count, range > min_range ? range : min_range, context, k.context);
+  if (handle != nullptr) k.finish(handle, k.context);
+}
+
 /// Records the bounding radius of a shape just added (`WorldData::common_bound`).
 template <int D>
 void note_bound(WorldData<D>& w, Scalar bound)
@@ -223,7 +260,8 @@ std::uint32_t integrate(WorldData<D>& w, Scalar dt, Own&& own)
   return count;
 }
 
-/// Adds every parameter of a world to a hash. A new `WorldDef` field belongs here too.
+/// Adds every parameter of a world to a hash. A new `WorldDef` field belongs here too, but for
+/// `WorldDef::workers`, which does not change results.
 template <int D>
 void hash_def(Fnv1a& h, const WorldDef<D>& d)
 {

@@ -27,6 +27,7 @@ constexpr Scalar max_mass = Scalar(1e9);     ///< kg
 constexpr Scalar min_radius = Scalar(1e-6);  ///< collision and bounding radius, m
 constexpr Scalar max_radius = Scalar(1e4);   ///< m
 constexpr Scalar gravity = Scalar(1e4);      ///< |gravity component|, m/s^2
+constexpr std::uint32_t max_workers = 64;    ///< `Workers::count`
 }  // namespace limits
 
 namespace detail {
@@ -113,6 +114,35 @@ struct BodyDef {
 enum class PairResponse : std::uint8_t {
   independent,  ///< paper 3.3.2: each body as against a fixed plane; energy can grow in piles
   momentum,     ///< the same samples, combined into one momentum-conserving impulse
+};
+
+/// A piece of a step that a world hands to the user's workers: `task(begin, end, task_context)`
+/// does the items [begin, end) of the task. Ranges of one task may run at the same time on
+/// different threads; each item must run exactly once.
+using TaskCallback = void(std::uint32_t begin, std::uint32_t end, void* task_context);
+/// Runs `task` over the items [0, count), in ranges of at least `min_range` items, on the user's
+/// workers (in the manner of Box2D v3's `b2EnqueueTaskCallback`). Returns a handle that the world
+/// passes to `FinishTaskCallback`, or nullptr when every item has run before it returns.
+/// `user_context` is `Workers::context`.
+using EnqueueTaskCallback = void*(TaskCallback* task, std::uint32_t count, std::uint32_t min_range,
+                                  void* task_context, void* user_context);
+/// Returns once every item of the task behind `user_task` (from `EnqueueTaskCallback`) has run.
+using FinishTaskCallback = void(void* user_task, void* user_context);
+
+/// Optional worker threads of a host program, reached through callbacks the user provides: the
+/// world starts no thread, allocates nothing and holds no lock. The hashed grid's pair search
+/// (`BroadPhase::grid`) is split into `count` parts by body index, and each part writes its pairs
+/// to its own share of the pair buffer; the parts are then joined in index order, so a world
+/// steps to the same bits with any `count` (a part that would overflow its share makes the step
+/// search again on one thread). Not part of the world's state: not hashed, not saved in
+/// snapshots, and a world that loads a snapshot keeps its own.
+struct Workers {
+  /// Parts the work is split into, in [1, `limits::max_workers`]; 1 (default): all of it on the
+  /// calling thread, and the callbacks are not used. Typical: the number of threads of the pool.
+  std::uint32_t count = 1;
+  EnqueueTaskCallback* enqueue = nullptr;  ///< required when `count` > 1
+  FinishTaskCallback* finish = nullptr;    ///< required when `count` > 1
+  void* context = nullptr;                 ///< passed to both callbacks as `user_context`
 };
 
 /// Where two bodies touch (see statsim/hull_contact.hpp).
@@ -233,6 +263,8 @@ struct WorldDef {
   /// `WorldCore::impacts`; only in worlds with a `MaxImpacts` above 0). Typical: 1 (Box2D's
   /// hit-event default); a body resting on the ground approaches at |g| dt each step.
   Scalar impact_threshold = 1;
+  /// Worker threads for the step (see `Workers`); none by default.
+  Workers workers;
 };
 
 /// A 64-bit word kept as two 32-bit halves, so that it needs only 4-byte alignment: a body's

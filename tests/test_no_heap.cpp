@@ -10,6 +10,9 @@
 
 #include "support/snapshot_scene.hpp"
 
+#include "common/task_pool.hpp"
+#include "tables/box.hpp"
+
 #include "statsim/queries.hpp"
 #include "statsim/snapshot.hpp"
 #include "statsim/world2.hpp"
@@ -166,6 +169,33 @@ TEST_CASE("no heap allocation in construction and stepping of a 10000-body stati
   Eigen::internal::set_is_malloc_allowed(true);
   CHECK(g_allocations.load() == 0);
   CHECK(w->count(MotionState::moving) < N_big);  // bodies did land: contacts were exercised
+  std::destroy_at(w);
+}
+
+TEST_CASE("no heap allocation with workers: the grid search and the hull candidates on two threads")
+{
+  tools::TaskPool pool(2);  // its threads start here, before the count
+  WorldDef3 def;
+  def.workers = pool.workers();
+  def.body_contacts = BodyContacts::hulls;
+  g_allocations = 0;
+  Eigen::internal::set_is_malloc_allowed(false);
+  g_counting = true;
+  auto* w = new (storage_big) World3<N_big>(def);
+  REQUIRE(w->construction_status() == Status::ok);
+  REQUIRE(w->add_shape(tables::box.view()).ok());
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).ok());
+  Pcg32 g(5, 6);
+  for (std::uint32_t i = 0; i < N_big; ++i) {
+    BodyDef3 b;
+    b.position = Vector3(g.uniform(-4, 4), g.uniform(-4, 4), g.uniform(0.2f, 3));
+    REQUIRE(w->add_body(b).ok());
+  }
+  for (int i = 0; i < 60; ++i) REQUIRE(w->step(1.0f / 60).status == Status::ok);
+  g_counting = false;
+  Eigen::internal::set_is_malloc_allowed(true);
+  CHECK(g_allocations.load() == 0);
+  CHECK(w->count(MotionState::moving) < N_big);
   std::destroy_at(w);
 }
 

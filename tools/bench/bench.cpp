@@ -268,7 +268,14 @@ public:
       for (auto& s : box2d_settings(body2_)) result.settings.push_back(s);
     }
     result.settings.push_back(
-        "statsim: WorldDef defaults (broad phase " + statsim_default_broad_phase() +
+        "statsim: WorldDef defaults but body contacts " +
+        std::string(o_.hull_contacts ? "at the hulls (BodyContacts::hulls) where the table has body-body data"
+                                     : "at the collision spheres (the default)") +
+        (o_.workers > 1 ? "; " + std::to_string(o_.workers) +
+                              " workers (WorldDef::workers, tools/common/task_pool.hpp: the CPU columns count the "
+                              "calling thread only, compare the step columns)"
+                        : std::string("; no workers")) +
+        " (broad phase " + statsim_default_broad_phase() +
         "; statistical-sap / statistical-grid force sweep-and-prune / the grid" +
         "; 4 support passes, shock propagation, sleep speed 0.05 m/s for 0.5 s), ground plane, float; world "
         "capacity: the smallest of 16, 128, 1024, 4096, 16384, 32768, 131072 holding N, 32 candidate pairs per body; "
@@ -337,8 +344,11 @@ private:
   {
     if (k.engine == "bullet") return make_bullet(bullet_shapes_, k.method, k.broadphase, *s3, o_.dt);
     if (k.engine == "box2d") return make_box2d(body2_, k.method, *s2, o_.dt);
-    if (o_.dim == 3) return make_statsim3(body3_, *s3, o_.seed, o_.dt, forced_broad_phase(k.method));
-    return make_statsim2(body2_, *s2, o_.seed, o_.dt, forced_broad_phase(k.method));
+    StatsimVariant v;
+    v.hull_contacts = o_.hull_contacts;
+    v.workers = o_.workers;
+    if (o_.dim == 3) return make_statsim3(body3_, *s3, o_.seed, o_.dt, forced_broad_phase(k.method), v);
+    return make_statsim2(body2_, *s2, o_.seed, o_.dt, forced_broad_phase(k.method), v);
   }
 
   void run_count(int n, BenchResult& result)

@@ -52,6 +52,8 @@ struct BenchOptions {
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes
   bool progress = true;              ///< progress lines on stderr
   bool chart_cpu = false;            ///< chart the thread CPU time instead of the wall-clock median
+  bool hull_contacts = true;         ///< statsim: BodyContacts::hulls (false: the default, collision spheres)
+  unsigned workers = 1;              ///< statsim: threads stepping each world (WorldDef::workers)
 };
 
 /// One cell of the benchmark: a method at one N with one broad phase.

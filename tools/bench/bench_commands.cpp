@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -125,6 +126,14 @@ void register_bench_commands(CLI::App& app)
   b->add_option("--chart", cmd->chart, "Write the log-log chart here as PNG, and as SVG beside it (FILE.svg)");
   b->add_option("--replot", cmd->replot, "Only redraw --chart from the CSV of an earlier run (--shape names the shape in the title)");
   b->add_flag("--quiet", cmd->quiet, "No progress on stderr");
+  b->add_option("--body-contacts", o.hull_contacts,
+                "statsim: where bodies touch each other, hulls (WorldDef::body_contacts = hulls) or spheres (the "
+                "runtime's default)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"hulls", true}, {"spheres", false}}))
+      ->default_str("hulls");
+  b->add_option("--workers", o.workers, "statsim: threads stepping each world (WorldDef::workers), 1 to 64")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   b->add_flag("--chart-cpu", cmd->options.chart_cpu,
               "Chart the thread CPU time per step instead of the wall-clock median (a machine shared with other work)");
   b->callback([cmd, shape]() {

@@ -173,6 +173,11 @@ bool statsim_table3(const std::string& shape, SignatureView<3>& out);
 struct StatsimVariant {
   bool rest_conditions = true;     ///< WorldDef::rest_conditions
   bool independent_pairs = false;  ///< WorldDef::pair_response = independent (default: momentum)
+  /// WorldDef::body_contacts = hulls where the table has body-body data (tools/fidelity/README.md,
+  /// "With hull contacts"); false: the runtime's default, collision spheres.
+  bool hull_contacts = true;
+  /// Threads stepping the world (WorldDef::workers, through a tools::TaskPool); 1: none started.
+  unsigned workers = 1;
 };
 /// A statsim world with any signature (e.g. one loaded at run time); `sig`'s storage must outlive it.
 /// `walls`: static planes besides the ground (at most 7).
@@ -187,9 +192,9 @@ std::unique_ptr<Sim> make_statsim3_mixed(const std::vector<SignatureView<3>>& si
                                           const std::vector<bullet::Plane>& walls = {});
 /// `broad_phase`: "" = the runtime's default, "grid" or "sap" (sweep-and-prune).
 std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
-                                   const std::string& broad_phase);
+                                   const std::string& broad_phase, const StatsimVariant& variant);
 std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,
-                                   const std::string& broad_phase);
+                                   const std::string& broad_phase, const StatsimVariant& variant);
 
 // ---- Bullet (bench_bullet.cpp) ------------------------------------------------------------------
 /// Shapes shared by every Bullet world of a run (built once).

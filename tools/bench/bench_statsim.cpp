@@ -1,6 +1,7 @@
 // The `statistical` method: statsim worlds (World3 / World2) with the shape's generated table,
 // the runtime's defaults (WorldDef), a ground plane and the scene's initial states.
 #include "bench/bench_internal.hpp"
+#include "common/task_pool.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
@@ -103,14 +104,15 @@ public:
   StatsimSim(const ShapeSet<D>& set, const Scene& scene, std::uint64_t seed, double dt,
              const std::string& broad_phase, const StatsimVariant& variant = {},
              const std::vector<bullet::Plane>& walls = {})
-      : dt_(static_cast<Scalar>(dt))
+      : dt_(static_cast<Scalar>(dt)), pool_(variant.workers > 1 ? std::make_unique<TaskPool>(variant.workers) : nullptr)
   {
     WorldDef<D> def;
     def.seed = seed;
     def.rest_conditions = variant.rest_conditions;
     // The benchmark and the fidelity scenes measure the hull contacts of tables that have
-    // body-body data (tools/fidelity/README.md, "With hull contacts").
-    def.body_contacts = BodyContacts::hulls;
+    // body-body data (tools/fidelity/README.md, "With hull contacts") unless told otherwise.
+    if (variant.hull_contacts) def.body_contacts = BodyContacts::hulls;
+    if (pool_) def.workers = pool_->workers();
     if (variant.independent_pairs) def.pair_response = PairResponse::independent;
     set_broad_phase(def.broad_phase, broad_phase);
     world_ = std::make_unique<WorldT>(def);
@@ -192,8 +194,9 @@ public:
   }
 
 private:
-  std::unique_ptr<WorldT> world_;
   Scalar dt_;
+  std::unique_ptr<TaskPool> pool_;  // declared before the world, which calls it, so that it outlives it
+  std::unique_ptr<WorldT> world_;
   StepResult last_{};
   std::uint32_t worst_dropped_ = 0;
 };
@@ -254,11 +257,11 @@ std::string statsim_default_broad_phase()
 }
 
 std::unique_ptr<Sim> make_statsim3(const Body3& body, const scenes::DropScene3& scene, std::uint64_t seed, double dt,
-                                   const std::string& broad_phase)
+                                   const std::string& broad_phase, const StatsimVariant& variant)
 {
   const std::optional<SignatureView<3>> t = table3(body.shape);
   if (!t) throw std::runtime_error("no statistical table for " + body.shape);
-  return make_sized<3>(ShapeSet<3>{{*t}, {body.mass}, {}}, scene, seed, dt, broad_phase);
+  return make_sized<3>(ShapeSet<3>{{*t}, {body.mass}, {}}, scene, seed, dt, broad_phase, variant);
 }
 
 bool statsim_table3(const std::string& shape, SignatureView<3>& out)
@@ -287,9 +290,9 @@ std::unique_ptr<Sim> make_statsim3_mixed(const std::vector<SignatureView<3>>& si
 }
 
 std::unique_ptr<Sim> make_statsim2(const Body2& body, const scenes::DropScene2& scene, std::uint64_t seed, double dt,
-                                   const std::string& broad_phase)
+                                   const std::string& broad_phase, const StatsimVariant& variant)
 {
-  return make_sized<2>(ShapeSet<2>{{tables::square2d.view()}, {body.mass}, {}}, scene, seed, dt, broad_phase);
+  return make_sized<2>(ShapeSet<2>{{tables::square2d.view()}, {body.mass}, {}}, scene, seed, dt, broad_phase, variant);
 }
 
 }  // namespace statsim::tools::bench
