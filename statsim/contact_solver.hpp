@@ -334,9 +334,10 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
     const bool a_asleep = a.state == MotionState::asleep;
     const bool b_asleep = b.state == MotionState::asleep;
     if (a_asleep || b_asleep) {
-      // An awake body hitting a sleeper fast enough wakes it; otherwise the sleeper is static.
+      // An awake body hitting a sleeper fast enough, or pressed deep into its hull, wakes it;
+      // otherwise the sleeper is static.
       const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(n);
-      if (approach > def.wake_speed) {
+      if (approach > def.wake_speed || wakes_by_overlap(w, a, b, c.depth, reach)) {
         if (a_asleep) wake(w, a);
         if (b_asleep) wake(w, b);
       }

@@ -261,6 +261,16 @@ bool hull_pair(const WorldData<D>& w, const Body<D>& a, const Body<D>& b)
          (sa.statistical || sb.statistical);
 }
 
+/// Whether a hull pair overlapping by `depth` of its `reach`, one of the two asleep, wakes the
+/// sleeper (`hull_wake_overlap`).
+template <int D>
+bool wakes_by_overlap(const WorldData<D>& w, const Body<D>& a, const Body<D>& b, Scalar depth, Scalar reach)
+{
+  if (!(depth > hull_wake_overlap * reach) || !hull_pair(w, a, b)) return false;
+  const Body<D>& presser = a.state == MotionState::asleep ? b : a;
+  return depth > 2 * hull_wake_overlap * reach || presser.slow_time == 0 || squared_norm(presser.angular_velocity) > 0;
+}
+
 /// The unit line of centres `e` and the distance of two bodies `d` apart (b - a); false when
 /// their bounding spheres are apart.
 template <int D>

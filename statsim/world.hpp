@@ -22,7 +22,7 @@
 ///  6. motion state: moving, settling (slow and touching), asleep (slow for `sleep_time`)
 ///     (rest_and_sleep.hpp).
 /// Sleeping bodies are not integrated and act as static supports until hit harder than
-/// `wake_speed`.
+/// `wake_speed` (or, with hull contacts, pressed deep: `detail::hull_wake_overlap`).
 
 #include "statsim/body_ops.hpp"
 #include "statsim/contact_solver.hpp"

@@ -210,6 +210,17 @@ Pcg32 rng_of(const WorldData<D>& w, const Body<D>& b)
   return Pcg32::resume(b.rng_state, body_stream(w.def.seed, std::uint32_t(&b - w.bodies)));
 }
 
+/// With hull contacts, a sleeper that an awake body presses more than this fraction of the
+/// separation at which their hulls touch into wakes, however slowly they approach, if that body
+/// moves or turns (its still time is 0, or it spins), and past twice this fraction whatever the
+/// pressing body does. A hull's reach grows as its body turns (toward its rest pose, or
+/// tipping), and asleep a neighbour cannot give way: held between it and other sleepers, the
+/// awake body would be thrown from one to the next by the overlap correction in every step and
+/// fall asleep inside whichever it last met. Collision spheres keep their reach when they turn.
+/// A still body below twice the fraction does not wake its neighbour, so that two bodies held
+/// together that deep by their own neighbours do not wake each other in turn for ever.
+constexpr Scalar hull_wake_overlap = Scalar(0.1);
+
 template <int D>
 void wake(WorldData<D>& w, Body<D>& b)
 {

@@ -104,6 +104,34 @@ TEST_CASE("hull contacts: a column of 10 cubes placed face to face holds its hei
   }
 }
 
+TEST_CASE("hull contacts: a body pressed deep between two sleepers wakes them, and all three part and sleep")
+{
+  // Three cubes of 0.2 m in a row on the ground, the outer two asleep 0.28 m apart, the middle one
+  // awake between them: it overlaps each by 6 cm, 30% of the separation at which they touch.
+  // Asleep, the outer ones could not give way, and the overlap correction would throw the
+  // middle one from one into the other in every step (`hull_wake_overlap`).
+  WorldDef3 def;
+  def.body_contacts = BodyContacts::hulls;
+  auto w = std::make_unique<World3<4>>(def);
+  const ShapeId box = w->add_shape(tables::box.view()).id;
+  REQUIRE(w->add_plane(Vector3(0, 0, 1), 0).status == Status::ok);
+  for (const Scalar x : {Scalar(-0.14), Scalar(0.14), Scalar(0)}) {
+    BodyDef3 b;
+    b.shape = box;
+    b.mass = 8;
+    b.position = Vector3(x, 0, Scalar(0.1));
+    const BodyId id = w->add_body(b).id;
+    if (x != 0) REQUIRE(w->sleep(id) == Status::ok);
+  }
+  for (int s = 0; s < 240; ++s) REQUIRE(w->step(Scalar(1) / 60).ok());
+  Scalar overlap, lowest;
+  pile_state<3>(*w, overlap, lowest);
+  CHECK(overlap < Scalar(0.03));
+  CHECK(w->body(0).position.x() < Scalar(-0.18));
+  CHECK(w->body(1).position.x() > Scalar(0.18));
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) CHECK(w->body(i).state == MotionState::asleep);
+}
+
 TEST_CASE("hull contacts: 3D piles of boxes and L-shapes end asleep, above the ground, without deep overlaps")
 {
   // Twelve piles: bodies held by several neighbours that slide down one into another and are
