@@ -82,8 +82,10 @@ namespace statsim {
 
 /// Which broad phase a world uses.
 enum class BroadPhase : std::uint8_t {
-  /// Uniform grid of cells one bounding diameter wide, hashed into a fixed table: each awake
-  /// body looks at the 3^D cells around it. Cost grows with awake bodies times their neighbours.
+  /// Uniform grid of cells as wide as the widest reach of two bodies (`detail::pair_radius`: the
+  /// bounding radius with hull contacts, else about the collision sphere), hashed into a fixed
+  /// table: each awake body looks at the 3^D cells around it. Cost grows with awake bodies times
+  /// their neighbours.
   grid,
   /// Sweep-and-prune along one axis (paper 4.1). Cost grows with the bodies whose intervals
   /// overlap on that axis, which in a wide pile is many more than the true neighbours.
@@ -110,8 +112,10 @@ constexpr std::uint32_t grid_buckets(std::uint32_t bodies)
 template <int D>
 struct GridItem {
   typename Space<D>::Vec position;  ///< centre, m
+  Scalar radius;                    ///< `detail::pair_radius`, m
   /// The body's index, plus `asleep_key` for a sleeper: from awake body i the search wants the
-  /// bodies with key > i (awake ones of higher index, and every sleeper) in one comparison.
+  /// bodies with key > i (awake ones of higher index, and every sleeper) in one comparison. A
+  /// bucket lists its bodies by key: the awake ones, then the sleepers.
   std::uint32_t key;
 };
 
@@ -158,14 +162,18 @@ struct SpatialHash {
     c = !(c > Scalar(-1e9)) ? Scalar(-1e9) : (c > Scalar(1e9) ? Scalar(1e9) : c);
     return std::int32_t(c);
   }
+  /// The term of cell coordinate c along axis k in a bucket's hash (the three are XORed).
+  static std::uint32_t hash_term(int k, std::int32_t c)
+  {
+    return std::uint32_t(c) * (k == 0 ? 73856093u : (k == 1 ? 19349663u : 83492791u));
+  }
   std::uint32_t bucket(std::int32_t x, std::int32_t y, std::int32_t z) const
   {
-    const std::uint32_t h = std::uint32_t(x) * 73856093u ^ std::uint32_t(y) * 19349663u ^ std::uint32_t(z) * 83492791u;
-    return h & (buckets - 1);
+    return (hash_term(0, x) ^ hash_term(1, y) ^ hash_term(2, z)) & (buckets - 1);
   }
 
   /// Sorts `count` bodies into buckets; `cell(i, c)` writes body i's integer cell coordinates and
-  /// `item(i)` returns its record.
+  /// `item(i)` returns its record. Within a bucket the records are in increasing key order.
   template <class CellOf, class ItemOf>
   void build(std::uint32_t count, CellOf&& cell, ItemOf&& item)
   {
@@ -181,14 +189,17 @@ struct SpatialHash {
       ++start[bucket(c[0], c[1], c[2]) + 1];
     }
     for (std::uint32_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
-    // Fill from the back so each bucket lists its bodies in increasing index order.
-    for (std::uint32_t i = count; i-- > 0;) {
-      std::int32_t c[3];
-      cell(i, c);
-      const std::uint32_t b = bucket(c[0], c[1], c[2]);
-      // Placement: the block held sweep-and-prune entries when that phase last ran.
-      new (&items[--start[b + 1]]) GridItem<D>(item(i));
-    }
+    // Fill from the back, sleepers first, so each bucket lists its bodies in increasing key order.
+    for (int sleepers = 1; sleepers >= 0; --sleepers)
+      for (std::uint32_t i = count; i-- > 0;) {
+        const GridItem<D> record = item(i);
+        if (((record.key & asleep_key) != 0) != (sleepers != 0)) continue;
+        std::int32_t c[3];
+        cell(i, c);
+        const std::uint32_t b = bucket(c[0], c[1], c[2]);
+        // Placement: the block held sweep-and-prune entries when that phase last ran.
+        new (&items[--start[b + 1]]) GridItem<D>(record);
+      }
     // The descending fill left start[b + 1] at the first item of bucket b: shift it to start[b],
     // so that bucket b is items[start[b]] .. items[start[b + 1] - 1].
     for (std::uint32_t b = 0; b < buckets; ++b) start[b] = start[b + 1];

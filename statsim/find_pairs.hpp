@@ -95,97 +95,104 @@ void measure_drift(WorldData<D>& w)
 template <int D>
 struct GridSearch {
   WorldData<D>* w;
-  Scalar half_cell;  ///< the widest bounding radius, in cells
-  Scalar common;     ///< `WorldData::common_bound`
-  bool regular;      ///< no body in a clamped cell (else every neighbouring cell is visited)
+  Scalar widest;  ///< the largest `pair_radius` of the bodies, m (half a cell)
+  bool regular;   ///< no body in a clamped cell (else every neighbouring cell is visited)
 };
 
 /// The cell of body i, as `SpatialHash::build` sorted it.
 template <int D>
-void grid_cell(const WorldData<D>& w, std::uint32_t i, std::int32_t* c)
+void grid_cell(const SpatialHash<D>& grid, const typename Space<D>::Vec& p, std::int32_t* c)
 {
-  for (int k = 0; k < 3; ++k) c[k] = k < D ? w.grid.cell_of(w.bodies[i].position[k], w.grid.inv_cell) : 0;
+  for (int k = 0; k < 3; ++k) c[k] = k < D ? grid.cell_of(p[k], grid.inv_cell) : 0;
 }
 
-/// The pairs that awake bodies of the bit words [first_word, end_word) find in the 3^D cells
-/// around their own, in body order, written to `out` while fewer than `capacity`; `found` counts
-/// them all and `examined` the records read.
+/// The pairs that awake bodies of the bit words [first_word, end_word) find around their cells,
+/// in body order, written to `out` while fewer than `capacity`; `found` counts them all and
+/// `examined` the records read.
+///
+/// A cell is as wide as the widest reach of two bodies, so a body can touch only bodies of the
+/// 3^D cells around its own. Each pair is found once: two bodies of one bucket from the awake one
+/// of lower key (a sleeper's key is above every awake one's); two bodies of neighbouring cells in
+/// different buckets from the one whose cell comes first in the order (z, y, x), unless that one
+/// sleeps, when the awake one looks back for sleepers. A bucket holds the cells of one hash,
+/// so a body met in a neighbour's bucket counts only if it lies in that very cell. Each awake
+/// body reads the records of its own bucket, the buckets of the cells after its own and the
+/// sleepers at the end of those before: about half of the records around it while bodies fall.
 template <int D>
 void search_grid(const GridSearch<D>& s, std::uint32_t first_word, std::uint32_t end_word, Pair* out,
                  std::uint32_t capacity, std::uint32_t& found, std::uint32_t& examined)
 {
+  using Vec = typename Space<D>::Vec;
   const WorldData<D>& w = *s.w;
   const SpatialHash<D>& grid = w.grid;
-  const Scalar widest = w.widest;
-  const Scalar common = s.common;
   constexpr int neighbours = D == 3 ? 27 : 9;
+  constexpr int own = neighbours / 2;
+  const auto add = [&](std::uint32_t i, std::uint32_t j) {
+    if (found < capacity) out[found] = Pair{i < j ? i : j, i < j ? j : i};
+    ++found;
+  };
+  // With no sleeper in the world the cells before a body's hold nothing it looks for.
+  const bool sleepers = w.awake_count < w.body_count;
   const auto search = [&](std::uint32_t i) {
     const Body<D>& bi = w.bodies[i];
-    const Scalar bound_i = common > 0 ? common : w.shapes[bi.shape].bounding_radius;
+    const Vec p = bi.position;
+    const Scalar radius = pair_radius(w, bi);
     std::int32_t c[3];
-    grid_cell(w, i, c);
+    grid_cell(grid, p, c);
     // Where the body is in its cell, in cells: a neighbouring cell holds a body it can touch only
-    // if the cell comes within the body's reach (its bounding radius and the widest one). Cells
-    // beyond it are skipped, with a margin for the rounding of x / cell.
-    Scalar low[3] = {0, 0, 0}, high[3] = {0, 0, 0};
+    // if the cell comes within the body's reach (its radius and the widest one). Cells beyond it
+    // are skipped, with a margin for the rounding of x / cell. gap[k][d + 1]: the squared gap to
+    // the cell at offset d along axis k; hash[k][d + 1]: that cell's term of the bucket's hash.
+    Scalar gap[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    std::uint32_t hash[3][3];
     Scalar margin = Scalar(0.01);
-    for (int k = 0; k < D; ++k) {
-      const Scalar u = bi.position[k] * grid.inv_cell;
-      low[k] = u - std::floor(u);
-      high[k] = 1 - low[k];
-      margin += std::fabs(u) * Scalar(1e-6);
+    for (int k = 0; k < 3; ++k) {
+      if (k < D) {
+        const Scalar u = p[k] * grid.inv_cell;
+        const Scalar low = u - std::floor(u), high = 1 - low;
+        gap[k][0] = low * low;
+        gap[k][2] = high * high;
+        margin += std::fabs(u) * Scalar(1e-6);
+      }
+      for (int d = 0; d < 3; ++d) hash[k][d] = SpatialHash<D>::hash_term(k, c[k] + d - 1);
     }
-    const Scalar r = bound_i * grid.inv_cell + s.half_cell + margin;
-    const Scalar r2 = r * r;
-    const Scalar reach_max = bound_i + Scalar(0.5) * widest;
+    const Scalar r = (radius + s.widest) * grid.inv_cell + margin;
+    const Scalar r2 = s.regular ? r * r : std::numeric_limits<Scalar>::infinity();
+    const Scalar reach_max = radius + s.widest;
     const Scalar reach_max2 = reach_max * reach_max;
-    // A bucket is searched once, where it first comes in the order of the cells, if any of
-    // its cells is within reach: the pairs come in the same order as from searching them all.
-    std::uint32_t bucket[neighbours];
-    bool visit[neighbours];
-    // Buckets by their low 6 bits: a clear bit proves a bucket new without comparing it with
-    // every one before (neighbouring cells rarely share a bucket).
-    std::uint64_t bucket_bits = 0;
-    for (int n = 0; n < neighbours; ++n) {
-      const std::int32_t d[3] = {n % 3 - 1, (n / 3) % 3 - 1, D == 3 ? n / 9 - 1 : 0};
-      bucket[n] = grid.bucket(c[0] + d[0], c[1] + d[1], c[2] + d[2]);
-      Scalar gap2 = 0;
-      for (int k = 0; k < D; ++k) {
-        const Scalar gap = d[k] < 0 ? low[k] : (d[k] > 0 ? high[k] : Scalar(0));
-        gap2 += gap * gap;
-      }
-      visit[n] = !s.regular || !(gap2 > r2);
-      const std::uint64_t bit = std::uint64_t(1) << (bucket[n] & 63u);
-      if (bucket_bits & bit) {
-        for (int k = 0; k < n; ++k)
-          if (bucket[k] == bucket[n]) {
-            visit[k] = visit[k] || visit[n];
-            visit[n] = false;
-            break;
+    const std::uint32_t mask = grid.buckets - 1;
+    const std::uint32_t home = (hash[0][1] ^ hash[1][1] ^ hash[2][1]) & mask;
+    int n = 0;
+    for (int z = 0; z < (D == 3 ? 3 : 1); ++z)
+      for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 3; ++x, ++n) {
+          const int dz = D == 3 ? z : 1;
+          if (!(gap[0][x] + gap[1][y] + gap[2][dz] <= r2)) continue;
+          if (n < own && !sleepers) continue;
+          const std::uint32_t b = n == own ? home : (hash[0][x] ^ hash[1][y] ^ hash[2][dz]) & mask;
+          if (n != own && b == home) continue;  // its bodies are the own bucket's
+          const GridItem<D>* const first = grid.items + grid.start[b];
+          const GridItem<D>* it = first;
+          const GridItem<D>* const end = grid.items + grid.start[b + 1];
+          if (n < own) {
+            // A cell before the body's: only its sleepers, at the end of the bucket.
+            for (it = end; it != first && (it[-1].key & asleep_key) != 0;) --it;
           }
-      }
-      bucket_bits |= bit;
-    }
-    for (int n = 0; n < neighbours; ++n) {
-      if (!visit[n]) continue;
-      const std::uint32_t b = bucket[n];
-      const GridItem<D>* it = grid.items + grid.start[b];
-      const GridItem<D>* const end = grid.items + grid.start[b + 1];
-      examined += std::uint32_t(end - it);
-      for (; it != end; ++it) {
-        // An awake pair is found once, from its lower index; a sleeper never looks itself.
-        if (it->key <= i) continue;
-        // As `candidate`, from the grid's copy of body j; bodies beyond the widest reach first,
-        // without reading body j (reach <= reach_max, so reach^2 <= reach_max^2).
-        const Scalar d2 = (it->position - bi.position).squaredNorm();
-        if (d2 > reach_max2) continue;
-        const std::uint32_t j = it->key & ~asleep_key;
-        const Scalar reach = bound_i + (common > 0 ? common : w.shapes[w.bodies[j].shape].bounding_radius);
-        if (d2 > reach * reach) continue;
-        if (found < capacity) out[found] = Pair{i < j ? i : j, i < j ? j : i};
-        ++found;
-      }
-    }
+          examined += std::uint32_t(end - it);
+          for (; it != end; ++it) {
+            if (n == own && it->key <= i) continue;
+            const Scalar d2 = (it->position - p).squaredNorm();
+            if (d2 > reach_max2) continue;
+            const Scalar reach = radius + it->radius;
+            if (d2 > reach * reach) continue;
+            if (n != own) {
+              std::int32_t e[3];
+              grid_cell(grid, it->position, e);
+              if (e[0] != c[0] + x - 1 || e[1] != c[1] + y - 1 || e[2] != c[2] + dz - 1) continue;
+            }
+            add(i, it->key & ~asleep_key);
+          }
+        }
   };
   for (std::uint32_t k = first_word; k < end_word; ++k)
     for (std::uint32_t bits = w.awake[k]; bits != 0; bits &= bits - 1) search(k * 32 + lowest_bit(bits));
@@ -294,29 +301,36 @@ bool search_grid_parts(const GridSearch<D>& s, std::uint32_t& found, std::uint32
   return true;
 }
 
-/// Pairs from the grid of cells one widest bounding diameter wide: each awake body looks at the
-/// bodies in the 3^D cells around its own. Returns how many were found (also those that did not
-/// fit the buffer).
+/// Pairs from the grid of cells one widest reach (twice the largest `pair_radius`) wide: each
+/// awake body looks at the bodies in the 3^D cells around its own. Returns how many were found
+/// (also those that did not fit the buffer).
 template <int D>
 std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
 {
   SpatialHash<D>& grid = w.grid;
-  const Scalar widest = w.widest;
-  grid.inv_cell = Scalar(1) / widest;
+  // The widest reach of this step. Collision spheres change size with spin, so it is measured
+  // afresh; it is never above the widest bounding diameter.
+  Scalar widest = 0;
+  for (std::uint32_t i = 0; i < w.body_count; ++i) {
+    const Scalar r = pair_radius(w, w.bodies[i]);
+    widest = r > widest ? r : widest;
+  }
+  if (!(widest > 0)) widest = Scalar(0.5) * w.widest;
+  grid.inv_cell = Scalar(1) / (2 * widest);
   // Bodies far out (or not finite) share clamped cells: then every neighbouring cell is visited.
   bool regular = true;
-  const auto cell = [&w, &regular](std::uint32_t i, std::int32_t* c) {
-    grid_cell(w, i, c);
+  const auto cell = [&w, &grid, &regular](std::uint32_t i, std::int32_t* c) {
+    grid_cell(grid, w.bodies[i].position, c);
     for (int k = 0; k < 3; ++k) regular = regular && c[k] > -100000000 && c[k] < 100000000;
   };
   const auto item = [&w](std::uint32_t i) {
     const Body<D>& b = w.bodies[i];
-    return GridItem<D>{b.position, b.state != MotionState::asleep ? i : i + asleep_key};
+    return GridItem<D>{b.position, pair_radius(w, b), b.state != MotionState::asleep ? i : i + asleep_key};
   };
   grid.build(w.body_count, cell, item);
   made_records(w, true);
   result.broad_phase_bodies += w.body_count;
-  const GridSearch<D> s{&w, Scalar(0.5) * widest * grid.inv_cell, w.common_bound, regular};
+  const GridSearch<D> s{&w, widest, regular};
   std::uint32_t found = 0, examined = 0;
 #if STATSIM_WORKERS
   // (The parts' records are on the stack of `search_grid_parts`, called only with workers.)

@@ -99,14 +99,6 @@ inline Scalar support_along(const ContactView<2>& c, const Vector2& u)
   return um * ((1 - t) * c.support[k] + t * c.support[k + 1]);
 }
 
-/// True when body-body contacts of this shape can use its hull: a statistical shape whose table
-/// has body-body data, or a plain sphere.
-template <int D>
-bool has_hull(const Shape<D>& s)
-{
-  return !s.statistical || s.signature.contact.present();
-}
-
 /// The support of a shape in body direction u: its map, or a plain sphere's radius.
 template <int D>
 Scalar shape_support(const Shape<D>& s, const typename Space<D>::Vec& u)

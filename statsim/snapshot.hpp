@@ -349,7 +349,7 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
     for (std::uint32_t k = 0; k < entries; ++k) {
       // Records never made yet are begun first, as the broad phase begins them.
       if (w.grid_layout)
-        new (&w.grid.items[k]) GridItem<D>{typename Space<D>::Vec(Space<D>::Vec::Zero()), 0};
+        new (&w.grid.items[k]) GridItem<D>{typename Space<D>::Vec(Space<D>::Vec::Zero()), 0, 0};
       else if (k >= w.entry_count)
         new (&w.entries[k]) SweepEntry{0, 0, k, 0};
       order_mark(w, k) = 0;

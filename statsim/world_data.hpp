@@ -194,6 +194,32 @@ void note_bound(WorldData<D>& w, Scalar bound)
   w.common_bound = w.shape_count == 0 || bound == w.common_bound ? bound : Scalar(0);
 }
 
+/// True when body-body contacts of this shape can use its hull: a statistical shape whose table
+/// has body-body data, or a plain sphere.
+template <int D>
+bool has_hull(const Shape<D>& s)
+{
+  return !s.statistical || s.signature.contact.present();
+}
+
+/// How far beyond its collision sphere, as a fraction of its radius, the grid looks for a body's
+/// contacts. The step's passes move bodies after the broad phase (out of the ground, out of one
+/// another), and a pair they bring into touch is met in that step only if it is a candidate.
+constexpr Scalar pair_margin = Scalar(0.1);
+
+/// The radius within which the grid looks for a body's contacts, m: its bounding radius where it
+/// may touch at its hull (`BodyContacts::hulls`), else its collision sphere's with `pair_margin`,
+/// at most its bounding radius. A bunny's collision sphere is about 0.6 of its bounding radius:
+/// the grid's cells shrink to 0.66 of the bounding diameter, and their volume to 0.3.
+template <int D>
+Scalar pair_radius(const WorldData<D>& w, const Body<D>& b)
+{
+  const Shape<D>& s = w.shapes[b.shape];
+  if (w.def.body_contacts == BodyContacts::hulls && has_hull(s)) return s.bounding_radius;
+  const Scalar r = b.radius * (1 + pair_margin);
+  return r < s.bounding_radius ? r : s.bounding_radius;
+}
+
 /// Lever arm of a body in the particle response: its radius for a sphere; 0 for a statistical
 /// body, whose sphere is not its shape, so friction on the sphere must not spin it (a spin it
 /// does not have would come back as speed).

@@ -84,8 +84,8 @@ enum class MotionState : std::uint8_t {
 struct ShapeDef {
   /// Radius of the collision sphere, m. Typical: 0.05 to 1.
   Scalar radius = Scalar(0.1);
-  /// Radius of a sphere about the centre of mass that holds the whole shape, m; the broad phase
-  /// uses it. 0 means "same as radius". Must be >= radius.
+  /// Radius of a sphere about the centre of mass that holds the whole shape, m; sweep-and-prune
+  /// uses it, and the grid with hull contacts. 0 means "same as radius". Must be >= radius.
   Scalar bounding_radius = 0;
   /// Restitution and friction of the shape's surface.
   Material material{};

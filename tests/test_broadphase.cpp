@@ -130,12 +130,14 @@ TEST_CASE("sweep over active entries finds exactly the pairs with an active memb
 TEST_CASE("world broad phase: pairs equal brute force on bounding spheres - skipping sleeping pairs")
 {
   // Collision spheres are tiny, so no contact moves a body and the end-of-step positions are the
-  // positions the broad phase saw.
+  // positions the broad phase saw. With hull contacts both broad phases look as far as the
+  // bounding spheres (`detail::pair_radius`).
   for (BroadPhase bp : {BroadPhase::grid, BroadPhase::sweep_and_prune, BroadPhase::automatic}) {
   CAPTURE(int(bp));
   WorldDef3 def;
   def.gravity = Vector3::Zero();
   def.broad_phase = bp;
+  def.body_contacts = BodyContacts::hulls;
   auto world = std::make_unique<World3<400, 8, 4000>>(def);
   ShapeDef small;
   small.radius = 1e-4f;
@@ -224,6 +226,7 @@ TEST_CASE("world broad phase with shapes of different bounding radii: pairs equa
     WorldDef3 def;
     def.gravity = Vector3::Zero();
     def.broad_phase = bp;
+    def.body_contacts = BodyContacts::hulls;  // both broad phases look as far as the bounding spheres
     auto world = std::make_unique<World3<300, 8, 3000>>(def);
     ShapeDef large, small;
     large.radius = small.radius = 1e-4f;  // no contact moves a body
@@ -255,6 +258,63 @@ TEST_CASE("world broad phase with shapes of different bounding radii: pairs equa
       total += want.size();
     }
     CHECK(total > 0);
+  }
+}
+
+TEST_CASE("at collision spheres the grid looks as far as the spheres and a margin, sweep-and-prune the bounding spheres")
+{
+  // Bodies at rest without gravity: the broad phase of the first step sees them where they were
+  // placed. Two shapes whose collision spheres are well inside their bounding spheres.
+  for (BroadPhase bp : {BroadPhase::grid, BroadPhase::sweep_and_prune}) {
+    CAPTURE(int(bp));
+    std::size_t total = 0, beyond_spheres = 0;
+    for (std::uint32_t seed = 1; seed <= 10; ++seed) {
+      WorldDef3 def;
+      def.gravity = Vector3::Zero();
+      def.broad_phase = bp;
+      auto world = std::make_unique<World3<300, 8, 3000>>(def);
+      ShapeDef large, small;
+      large.radius = 0.15f;
+      large.bounding_radius = 0.4f;
+      small.radius = 0.1f;
+      small.bounding_radius = 0.105f;  // its sphere and margin reach beyond: the bound holds
+      const ShapeId shapes[2] = {world->add_shape(large).id, world->add_shape(small).id};
+      Pcg32 rng(seed, 0);
+      std::vector<Vector3> at;
+      for (int i = 0; i < 300; ++i) {
+        BodyDef3 b;
+        b.shape = shapes[i % 3 == 0 ? 0 : 1];
+        b.position = Vector3(rng.uniform(-2.5f, 2.5f), rng.uniform(-2.5f, 2.5f), rng.uniform(-1, 1));
+        b.asleep = i % 7 == 0;
+        at.push_back(b.position);
+        REQUIRE(world->add_body(b).ok());
+      }
+      REQUIRE(world->step(1.0f / 60).ok());
+      const auto reach_of = [&](std::uint32_t i) {
+        const ShapeDef& s = i % 3 == 0 ? large : small;
+        if (bp == BroadPhase::sweep_and_prune) return s.bounding_radius;
+        return std::min(s.bounding_radius, s.radius * (1 + detail::pair_margin));
+      };
+      PairList want;
+      for (std::uint32_t i = 0; i < 300; ++i)
+        for (std::uint32_t j = i + 1; j < 300; ++j) {
+          if (i % 7 == 0 && j % 7 == 0) continue;  // two sleepers
+          const float reach = reach_of(i) + reach_of(j);
+          const float d2 = (at[i] - at[j]).squaredNorm();
+          if (d2 > reach * reach) continue;
+          want.emplace_back(i, j);
+          const float spheres = (i % 3 == 0 ? large : small).radius + (j % 3 == 0 ? large : small).radius;
+          if (d2 > spheres * spheres) ++beyond_spheres;
+        }
+      PairList got;
+      for (std::uint32_t k = 0; k < world->pair_count(); ++k) got.emplace_back(world->pairs()[k].a, world->pairs()[k].b);
+      REQUIRE(sorted(got) == want);
+      total += want.size();
+    }
+    MESSAGE(total << " candidate pairs, " << beyond_spheres << " of them not touching");
+    CHECK(total > 400);
+    if (bp == BroadPhase::grid) CHECK(beyond_spheres * 5 < total);
+    else CHECK(beyond_spheres * 2 > total);
   }
 }
 

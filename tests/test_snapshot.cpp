@@ -131,7 +131,7 @@ TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (hull contacts, pile 
   def.broad_phase = BroadPhase::grid;
   def.seed = 77;
   anchors = 0;
-  for (int at : {150, 240}) check_scene<3, World3s>(def, at);
+  for (int at : {150, 180}) check_scene<3, World3s>(def, at);
   CHECK(anchors > 0);
   def.broad_phase = BroadPhase::sweep_and_prune;
   def.sweep_axis = 1;
