@@ -1,7 +1,8 @@
 # Footprint of firmware variants, from arm-none-eabi-size (sections) and arm-none-eabi-nm (symbol
 # sizes; the same figures as the map file): flash split into code and tables, RAM into the two
-# worlds, the rest of .data + .bss, and the stack reserved. Prints a Markdown table.
-#   cmake -DDIR=build-fw -DNM=arm-none-eabi-nm -DVARIANTS="fw_box_64_f32;..." -P footprint.cmake
+# worlds, the rest of .data + .bss, and the stack reserved. Prints a Markdown table and, with
+# -DCSV=FILE, writes the same figures in bytes as CSV for tools/plot/footprint.py.
+#   cmake -DDIR=build-fw -DNM=arm-none-eabi-nm -DVARIANTS="fw_box_64_f32;..." [-DCSV=FILE] -P footprint.cmake
 string(REPLACE "-nm" "-size" SIZE "${NM}")
 
 function(kb out bytes)
@@ -11,6 +12,7 @@ function(kb out bytes)
 endfunction()
 
 set(rows "| variant | flash: code | flash: tables | flash total | RAM: 3D world | RAM: 2D world | RAM: other data+bss | RAM: stack | RAM total | 3D world per body | 2D world per body |\n|---|---|---|---|---|---|---|---|---|---|---|\n")
+set(csv "variant,bodies,code_bytes,tables_bytes,flash_bytes,world3_bytes,world2_bytes,other_bytes,stack_bytes,ram_bytes,world3_per_body,world2_per_body\n")
 foreach(v IN LISTS VARIANTS)
   set(elf ${DIR}/${v}.elf)
   execute_process(COMMAND ${SIZE} -A ${elf} OUTPUT_VARIABLE sections RESULT_VARIABLE rc)
@@ -53,6 +55,11 @@ foreach(v IN LISTS VARIANTS)
   foreach(x flash code tables world3 world2 ram)
     kb(${x}_kb ${${x}})
   endforeach()
+  string(APPEND csv "${v},${n},${code},${tables},${flash},${world3},${world2},${other},${sec_stack},${ram},${per3},${per2}\n")
   string(APPEND rows "| `${v}` | ${code_kb} | ${tables_kb} | ${flash_kb} | ${world3_kb} | ${world2_kb} | ${other} B | ${sec_stack} B | ${ram_kb} | ${per3} B | ${per2} B |\n")
 endforeach()
 message("${rows}")
+if(CSV)
+  file(WRITE "${CSV}" "${csv}")
+  message("wrote ${CSV}")
+endif()
