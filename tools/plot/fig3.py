@@ -4,7 +4,6 @@ first contact with a line against |w|/|v|, as the min..max range, the mean and m
     python3 tools/plot/fig3.py DIR/fig3.csv --out DIR/fig3.png   # writes fig3.png and fig3.svg
 """
 
-import argparse
 import math
 
 import style
@@ -19,15 +18,8 @@ MEAN = style.color(1)
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("csv", help="fig3.csv of `statsim fig3` (ratio,min,mean,std,max,trials)")
-    parser.add_argument("--out", required=True, help="FILE.png: writes FILE.png and FILE.svg")
-    args = parser.parse_args()
-    style.outputs(args.out)  # a bad name fails before anything is read
-
-    rows = style.read_csv(args.csv, ["ratio", "min", "mean", "std", "max", "trials"])
-    if not rows:
-        style.fail(f"{args.csv}: no rows")
+    args, rows = style.csv_chart(__doc__, "fig3.csv of `statsim fig3` (ratio,min,mean,std,max,trials)",
+                                 ["ratio", "min", "mean", "std", "max", "trials"])
     col = {k: style.column(rows, k, args.csv) for k in ("ratio", "min", "mean", "std", "max", "trials")}
     trials = [int(t) for t in col["trials"]]
     x = col["ratio"]

@@ -5,8 +5,6 @@ world, against the goals of the footprint table (examples/firmware/README.md).
     python3 tools/plot/footprint.py build/firmware/footprint.csv --out DIR/footprint.png   # and .svg
 """
 
-import argparse
-
 import style
 
 COLUMNS = ["variant", "bodies", "code_bytes", "tables_bytes", "world3_per_body", "world2_per_body"]
@@ -24,15 +22,7 @@ WORLD2 = style.color(3)
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("csv", help="footprint.csv of the firmware build's footprint target")
-    parser.add_argument("--out", required=True, help="FILE.png: writes FILE.png and FILE.svg")
-    args = parser.parse_args()
-    style.outputs(args.out)  # a bad name fails before anything is read
-
-    rows = style.read_csv(args.csv, COLUMNS)
-    if not rows:
-        style.fail(f"{args.csv}: no rows")
+    args, rows = style.csv_chart(__doc__, "footprint.csv of the firmware build's footprint target", COLUMNS)
     names = [r["variant"] for r in rows]
     col = {k: style.column(rows, k, args.csv) for k in COLUMNS[1:]}
     code_kb = [b / 1024 for b in col["code_bytes"]]

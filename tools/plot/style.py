@@ -11,6 +11,7 @@ matplotlib: status 3, NO_MATPLOTLIB, and the package to install). The host tools
 through tools/common/plot.hpp, which picks a python3 that has matplotlib.
 """
 
+import argparse
 import csv
 import json
 import math
@@ -87,6 +88,21 @@ def read_csv(path, columns):
     if missing:
         fail(f"{path}: no column {', '.join(missing)} (header: {','.join(header) or 'empty'})")
     return rows
+
+
+def csv_chart(doc, csv_help, columns):
+    """The command line of a chart drawn from one CSV (`CSV --out FILE.png`): its arguments and
+    the CSV's rows, checked for `columns` and for at least one row. A bad --out name fails before
+    anything is read."""
+    parser = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("csv", help=csv_help)
+    parser.add_argument("--out", required=True, help="FILE.png: writes FILE.png and FILE.svg")
+    args = parser.parse_args()
+    outputs(args.out)
+    rows = read_csv(args.csv, columns)
+    if not rows:
+        fail(f"{args.csv}: no rows")
+    return args, rows
 
 
 def read_json(path):
