@@ -172,10 +172,11 @@ struct SpatialHash {
     return (hash_term(0, x) ^ hash_term(1, y) ^ hash_term(2, z)) & (buckets - 1);
   }
 
-  /// Sorts `count` bodies into buckets; `cell(i, c)` writes body i's integer cell coordinates and
-  /// `item(i)` returns its record. Within a bucket the records are in increasing key order.
-  template <class CellOf, class ItemOf>
-  void build(std::uint32_t count, CellOf&& cell, ItemOf&& item)
+  /// Sorts `count` bodies into buckets; `cell(i, c)` writes body i's integer cell coordinates,
+  /// `item(i)` returns its record and `asleep(i)` tells whether its key has `asleep_key`. Within
+  /// a bucket the records are in increasing key order.
+  template <class CellOf, class ItemOf, class Asleep>
+  void build(std::uint32_t count, CellOf&& cell, ItemOf&& item, Asleep&& asleep)
   {
     // Size the table to the bodies present, not to the capacity: every build walks all buckets
     // three times, and a world of 100 bodies with room for 10,000 would spend most of its step
@@ -192,13 +193,12 @@ struct SpatialHash {
     // Fill from the back, sleepers first, so each bucket lists its bodies in increasing key order.
     for (int sleepers = 1; sleepers >= 0; --sleepers)
       for (std::uint32_t i = count; i-- > 0;) {
-        const GridItem<D> record = item(i);
-        if (((record.key & asleep_key) != 0) != (sleepers != 0)) continue;
+        if (asleep(i) != (sleepers != 0)) continue;
         std::int32_t c[3];
         cell(i, c);
         const std::uint32_t b = bucket(c[0], c[1], c[2]);
         // Placement: the block held sweep-and-prune entries when that phase last ran.
-        new (&items[--start[b + 1]]) GridItem<D>(record);
+        new (&items[--start[b + 1]]) GridItem<D>(item(i));
       }
     // The descending fill left start[b + 1] at the first item of bucket b: shift it to start[b],
     // so that bucket b is items[start[b]] .. items[start[b + 1] - 1].

@@ -323,11 +323,13 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
     grid_cell(grid, w.bodies[i].position, c);
     for (int k = 0; k < 3; ++k) regular = regular && c[k] > -100000000 && c[k] < 100000000;
   };
-  const auto item = [&w](std::uint32_t i) {
+  // The awake bit set tells the sleepers without reading the bodies; each record is made once.
+  const auto asleep = [&w](std::uint32_t i) { return !bit_set(w.awake, i); };
+  const auto item = [&w, &asleep](std::uint32_t i) {
     const Body<D>& b = w.bodies[i];
-    return GridItem<D>{b.position, pair_radius(w, b), b.state != MotionState::asleep ? i : i + asleep_key};
+    return GridItem<D>{b.position, pair_radius(w, b), asleep(i) ? i + asleep_key : i};
   };
-  grid.build(w.body_count, cell, item);
+  grid.build(w.body_count, cell, item, asleep);
   made_records(w, true);
   result.broad_phase_bodies += w.body_count;
   const GridSearch<D> s{&w, widest, regular};
