@@ -18,24 +18,46 @@
 
 namespace statsim {
 
-/// A candidate pair of bodies, by index.
+/// A candidate pair of bodies, by index, a < b: 8 bytes, as a pair buffer holds several per body.
+/// (`b` and `witness` are bit-fields: copy them into an integer before binding a reference.)
 struct Pair {
   std::uint32_t a;
-  std::uint32_t b;
+  std::uint32_t b : 24;  ///< body indices have `body_index_bits` (20) bits
   /// With hull contacts, the candidate normal the impact pass found for a touching pair
-  /// (`detail::find_hull_witness`), which the later passes of the step reuse.
-  std::uint32_t witness = 0;
+  /// (`detail::find_hull_witness`), which the later passes of the step reuse; 0 in a new pair.
+  std::uint32_t witness : 8;
 };
 
-/// One body's interval on the sweep axis.
+/// One body's interval on the sweep axis: 12 bytes with float `Scalar`.
 struct SweepEntry {
   Scalar lo;
   Scalar hi;
-  std::uint32_t body;
-  std::uint32_t active;  ///< 1 when awake: pairs of two inactive entries are not wanted
+  std::uint32_t body : 31;
+  std::uint32_t active : 1;  ///< 1 when awake: pairs of two inactive entries are not wanted
 };
 
 namespace detail {
+
+/// A new candidate pair of bodies a < b, as the broad phases make it.
+inline Pair make_pair(std::uint32_t a, std::uint32_t b)
+{
+  Pair p;
+  p.a = a;
+  p.b = b & 0xffffffu;
+  p.witness = 0;
+  return p;
+}
+
+/// An entry of a body that the next sweep places (its interval is filled in then).
+inline SweepEntry sweep_entry(std::uint32_t body, bool active)
+{
+  SweepEntry e;
+  e.lo = 0;
+  e.hi = 0;
+  e.body = body & 0x7fffffffu;
+  e.active = active ? 1u : 0u;
+  return e;
+}
 
 /// Sorts `entries` by `lo`, stably, in place. Returns the number of element moves, which is small
 /// when the order is coherent from frame to frame.

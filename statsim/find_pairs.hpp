@@ -24,7 +24,7 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_
   const Scalar reach = common_reach > 0 ? common_reach
                                         : w.shapes[ba.shape].bounding_radius + w.shapes[bb.shape].bounding_radius;
   if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
-  if (found < w.max_pairs) w.pairs[found] = a < b ? Pair{a, b} : Pair{b, a};
+  if (found < w.max_pairs) w.pairs[found] = a < b ? make_pair(a, b) : make_pair(b, a);
   ++found;
 }
 
@@ -128,7 +128,7 @@ void search_grid(const GridSearch<D>& s, std::uint32_t first_word, std::uint32_t
   constexpr int neighbours = D == 3 ? 27 : 9;
   constexpr int own = neighbours / 2;
   const auto add = [&](std::uint32_t i, std::uint32_t j) {
-    if (found < capacity) out[found] = Pair{i < j ? i : j, i < j ? j : i};
+    if (found < capacity) out[found] = make_pair(i < j ? i : j, i < j ? j : i);
     ++found;
   };
   // With no sleeper in the world the cells before a body's hold nothing it looks for.
@@ -353,7 +353,7 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   if (w.awake_count == 0 && w.sweep_current && w.entry_count == w.body_count) return 0;
   // Bodies added since the last sweep join at the end, in order of creation.
   for (; w.entry_count < w.body_count; ++w.entry_count)
-    new (&w.entries[w.entry_count]) SweepEntry{0, 0, w.entry_count, 1};
+    new (&w.entries[w.entry_count]) SweepEntry(sweep_entry(w.entry_count, true));
   const int axis = w.def.sweep_axis;
   const Scalar common = w.common_bound;
   Scalar widest = 0;
@@ -381,7 +381,7 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
 }
 
 /// Hands the broad phase's block from sweep-and-prune to the grid or back, keeping the sweep order:
-/// entry k (16 bytes at 16 k) to index k (4 bytes at 4 k) in increasing k, and back in decreasing
+/// entry k (12 bytes at 12 k) to index k (4 bytes at 4 k) in increasing k, and back in decreasing
 /// k, so that nothing is overwritten before it is read.
 template <int D>
 void switch_broad_phase(WorldData<D>& w)
@@ -394,7 +394,7 @@ void switch_broad_phase(WorldData<D>& w)
   } else {
     for (std::uint32_t k = w.entry_count; k-- > 0;) {
       const std::uint32_t body = w.order[k];
-      new (&w.entries[k]) SweepEntry{0, 0, body, 1};
+      new (&w.entries[k]) SweepEntry(sweep_entry(body, true));
     }
   }
   w.grid_layout = !w.grid_layout;

@@ -190,7 +190,9 @@ Scalar largest_packing(const Shape<D>& s)
 /// against); `no_witness` when the pair is apart: at least that distance away, or (first, from
 /// e alone) farther than the distance along e times `packing`, the largest packing ratio either
 /// shape has.
-constexpr std::uint32_t no_witness = 0xffffffffu;
+constexpr std::uint32_t no_witness = 0xffu;
+// Candidates are numbered up to 2 `max_contact_faces`, below `no_witness`, in `Pair::witness`'s 8 bits.
+static_assert(2 * max_contact_faces < no_witness, "candidate numbers must fit Pair::witness");
 
 template <int D>
 std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, const Body<D>& b,
@@ -287,7 +289,7 @@ void search_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, co
   const Scalar pa = sa.statistical ? sa.largest_packing : Scalar(1);
   const Scalar pb = sb.statistical ? sb.largest_packing : Scalar(1);
   pair.witness =
-      find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb, pair_packing(sa, sb, a.shape == b.shape, e));
+      find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb, pair_packing(sa, sb, a.shape == b.shape, e)) & 0xffu;
 }
 
 /// Whether the pair touches and how: at their collision spheres, or (`BodyContacts::hulls`,

@@ -182,9 +182,15 @@ std::size_t write_snapshot(const WorldData<D>& w, unsigned char* buf)
 /// entries' `active` (`find_pairs_sweep` sets every one before it sorts, or returns before it
 /// reads any); in the grid layout the grid's records (built from scratch every step).
 template <int D>
-std::uint32_t& order_mark(WorldData<D>& w, std::uint32_t slot)
+bool order_mark(const WorldData<D>& w, std::uint32_t slot)
 {
-  return w.grid_layout ? w.grid.items[slot].key : w.entries[slot].active;
+  return (w.grid_layout ? w.grid.items[slot].key : std::uint32_t(w.entries[slot].active)) != 0;
+}
+template <int D>
+void set_order_mark(WorldData<D>& w, std::uint32_t slot, bool on)
+{
+  if (w.grid_layout) w.grid.items[slot].key = on ? 1u : 0u;
+  else w.entries[slot].active = on ? 1u : 0u;
 }
 
 /// One body slot's state as it was read, before it is checked.
@@ -351,19 +357,19 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
       if (w.grid_layout)
         new (&w.grid.items[k]) GridItem<D>{typename Space<D>::Vec(Space<D>::Vec::Zero()), 0, 0};
       else if (k >= w.entry_count)
-        new (&w.entries[k]) SweepEntry{0, 0, k, 0};
-      order_mark(w, k) = 0;
+        new (&w.entries[k]) SweepEntry(sweep_entry(k, false));
+      set_order_mark(w, k, false);
     }
   for (std::uint32_t k = 0; k < entries; ++k) {
     const std::uint32_t slot = in.u32();
     if (!in.ok() || slot >= entries) return Status::invalid_snapshot;
     if (!commit) {
-      if (order_mark(w, slot) != 0) return Status::invalid_snapshot;
-      order_mark(w, slot) = 1;
+      if (order_mark(w, slot)) return Status::invalid_snapshot;
+      set_order_mark(w, slot, true);
     } else if (flags & snap_grid_layout) {
       new (&w.order[k]) std::uint32_t(slot);
     } else {
-      new (&w.entries[k]) SweepEntry{0, 0, slot, 1};
+      new (&w.entries[k]) SweepEntry(sweep_entry(slot, true));
     }
   }
   if (in.offset() != size - 8) return Status::invalid_snapshot;  // bytes left over

@@ -12,6 +12,8 @@
 namespace statsim {
 namespace detail {
 
+static_assert(body_index_bits <= 24, "Pair::b holds a body index in 24 bits");
+
 /// Storage of a World, a base class so that it is constructed before the core that points into it.
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes, std::uint32_t MaxPairs, std::uint32_t MaxShapes,
           std::uint32_t MaxImpacts, BroadPhase Phases>

@@ -79,7 +79,7 @@ TEST_CASE("sweep-and-prune finds exactly the brute-force pairs - also after many
     std::vector<Vector3> vel(n);
     for (Vector3& v : vel) v = Vector3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 0.05f;
     std::vector<SweepEntry> entries(n);
-    for (int i = 0; i < n; ++i) entries[i] = SweepEntry{0, 0, std::uint32_t(i), 1};
+    for (int i = 0; i < n; ++i) entries[i] = detail::sweep_entry(std::uint32_t(i), true);
     const int axis = scene % 3;
     std::size_t total = 0;
     for (int step = 0; step < 80; ++step) {
@@ -110,7 +110,9 @@ TEST_CASE("sweep over active entries finds exactly the pairs with an active memb
     for (int i = 0; i < n; ++i) {
       widest = std::max(widest, 2 * s[i].r);
       active[i] = rng.uniform() < 0.2f * float(scene);
-      entries[i] = SweepEntry{s[i].c.x() - s[i].r, s[i].c.x() + s[i].r, std::uint32_t(i), active[i] ? 1u : 0u};
+      entries[i] = detail::sweep_entry(std::uint32_t(i), active[i]);
+      entries[i].lo = s[i].c.x() - s[i].r;
+      entries[i].hi = s[i].c.x() + s[i].r;
     }
     detail::insertion_sort(entries.data(), std::uint32_t(n));
     PairList got;
@@ -353,4 +355,26 @@ TEST_CASE("pair buffer overflow is reported with the number dropped")
   CHECK(r.pairs_found == 190);
   CHECK(r.pairs_dropped == 180);
   CHECK(world.pair_count() == 10);
+}
+
+TEST_CASE("a pair record is 8 bytes and a sweep entry 12: indices, witness and awake bit survive their bit-fields")
+{
+  // The firmware's RAM per body counts several pair records and one entry (examples/firmware/README.md).
+  CHECK(sizeof(Pair) == 8);
+  CHECK(sizeof(SweepEntry) == 2 * sizeof(Scalar) + 4);
+  const std::uint32_t last = (1u << body_index_bits) - 1;
+  Pair p = detail::make_pair(last - 1, last);
+  const Pair& q = p;  // doctest binds its operands by reference: a const one copies a bit-field
+  CHECK(q.a == last - 1);
+  CHECK(q.b == last);
+  CHECK(q.witness == 0);
+  p.witness = detail::no_witness;
+  CHECK(q.witness == detail::no_witness);
+  CHECK(q.b == last);
+  p.witness = 2 * max_contact_faces;  // the highest candidate of two shapes
+  CHECK(q.witness == 2 * max_contact_faces);
+  const SweepEntry e = detail::sweep_entry(last, true);
+  CHECK(e.body == last);
+  CHECK(e.active == 1);
+  CHECK(detail::sweep_entry(last, false).active == 0);
 }

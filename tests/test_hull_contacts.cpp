@@ -326,7 +326,7 @@ TEST_CASE("hull contacts: the distance at which two L-shapes touch changes conti
       for (int it = 0; it < 40; ++it) {
         const Scalar mid = Scalar(0.5) * (lo + hi);
         b.position = a.position + e * mid;
-        Pair pair{0, 1};
+        Pair pair = detail::make_pair(0, 1);
         Contact<2> c;
         Scalar reach, slop;
         (detail::body_contact(w, a, b, pair, true, Scalar(0), c, reach, slop) ? lo : hi) = mid;
