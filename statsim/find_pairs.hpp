@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The broad phase of a step: candidate pairs of bodies whose bounding spheres overlap, from the
-/// hashed grid or sweep-and-prune (`broadphase.hpp`), into the world's pair buffer. Pairs with a
+/// The broad phase of a step: candidate pairs of bodies whose spheres of `pair_radius` overlap,
+/// from the hashed grid or sweep-and-prune (`broadphase.hpp`), into the world's pair buffer. Pairs with a
 /// sleeping body are found only from the awake one; two sleepers are never a pair.
 
 #include "statsim/world_data.hpp"
@@ -14,16 +14,23 @@
 namespace statsim {
 namespace detail {
 
-/// Records a candidate pair if the bounding spheres overlap; counts it either way it fits.
-/// `common_reach`: twice `WorldData::common_bound` (the same sum as the two radii), or 0.
+/// Records a candidate pair if the spheres of their `pair_radius` overlap, as the grid finds
+/// them; counts it either way it fits. The bounding spheres are tested first: most pairs of a
+/// sweep are apart, and that test needs no radius of the pair when every shape has the same
+/// bounding radius (`common_reach`: twice `WorldData::common_bound`, or 0). `bounding`: the pair
+/// radii are the bounding radii (hull contacts, every shape with a hull).
 template <int D>
-void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_reach, std::uint32_t& found)
+void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_reach, bool bounding,
+               std::uint32_t& found)
 {
   const Body<D>& ba = w.bodies[a];
   const Body<D>& bb = w.bodies[b];
-  const Scalar reach = common_reach > 0 ? common_reach
+  const Scalar bound = common_reach > 0 ? common_reach
                                         : w.shapes[ba.shape].bounding_radius + w.shapes[bb.shape].bounding_radius;
-  if ((bb.position - ba.position).squaredNorm() > reach * reach) return;
+  const Scalar d2 = (bb.position - ba.position).squaredNorm();
+  if (d2 > bound * bound) return;
+  const Scalar reach = bounding ? bound : pair_radius(w, ba) + pair_radius(w, bb);
+  if (d2 > reach * reach) return;
   if (found < w.max_pairs) w.pairs[found] = a < b ? make_pair(a, b) : make_pair(b, a);
   ++found;
 }
@@ -374,9 +381,12 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   // Its overlaps are not counted in `StepResult::pairs_examined`: a counter in the sweep's inner
   // loop costs it more than the count is worth.
   std::uint32_t found = 0;
+  // With hull contacts every pair radius is the bounding radius where every shape has a hull.
+  bool bounding = w.def.body_contacts == BodyContacts::hulls;
+  for (std::uint32_t k = 0; k < w.shape_count; ++k) bounding = bounding && has_hull(w.shapes[k]);
   const Scalar common_reach = common + common;
   sweep_active(w.entries, w.body_count, widest,
-               [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, common_reach, found); });
+               [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, common_reach, bounding, found); });
   return found;
 }
 

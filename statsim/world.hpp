@@ -10,8 +10,8 @@
 ///  1. integrate awake bodies (semi-implicit Euler; orientation without trigonometry;
 ///     world_data.hpp; a body rolling on a slope in substeps with its slope contacts,
 ///     slope_contact.hpp) and set the statistical bodies' collision radii (rest_and_sleep.hpp);
-///  2. broad phase (hashed grid on `detail::pair_radius`, or sweep-and-prune on the bounding
-///     radius; find_pairs.hpp);
+///  2. broad phase: pairs within `detail::pair_radius` of each other, from a hashed grid or from
+///     sweep-and-prune (intervals on the bounding radius; find_pairs.hpp);
 ///  3. impact pass: body-plane then body-body contacts get the bodies' response (the statistical
 ///     response for statistical bodies, the particle response for plain spheres); planes push
 ///     bodies out of them (contact_solver.hpp, as are 4 and 5);

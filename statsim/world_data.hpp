@@ -202,15 +202,16 @@ bool has_hull(const Shape<D>& s)
   return !s.statistical || s.signature.contact.present();
 }
 
-/// How far beyond its collision sphere, as a fraction of its radius, the grid looks for a body's
-/// contacts. The step's passes move bodies after the broad phase (out of the ground, out of one
+/// How far beyond its collision sphere, as a fraction of its radius, the broad phase looks for a
+/// body's contacts. The step's passes move bodies after the broad phase (out of the ground, out of one
 /// another), and a pair they bring into touch is met in that step only if it is a candidate.
 constexpr Scalar pair_margin = Scalar(0.1);
 
-/// The radius within which the grid looks for a body's contacts, m: its bounding radius where it
-/// may touch at its hull (`BodyContacts::hulls`), else its collision sphere's with `pair_margin`,
-/// at most its bounding radius. A bunny's collision sphere is about 0.6 of its bounding radius:
-/// the grid's cells shrink to 0.66 of the bounding diameter, and their volume to 0.3.
+/// The radius within which the broad phase looks for a body's contacts, m: its bounding radius
+/// where it may touch at its hull (`BodyContacts::hulls`), else its collision sphere's with
+/// `pair_margin`, at most its bounding radius. A bunny's collision sphere is about 0.6 of its
+/// bounding radius: the grid's cells shrink to 0.66 of the bounding diameter, and their volume
+/// to 0.3; a pile's candidate pairs, and the pair buffer it needs, to a fifth.
 template <int D>
 Scalar pair_radius(const WorldData<D>& w, const Body<D>& b)
 {

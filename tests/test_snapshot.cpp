@@ -120,7 +120,7 @@ TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (collision spheres, s
 {
   WorldDef3 def;
   def.impact_threshold = Scalar(0.5);
-  for (int at : {40, 150, 300}) check_scene<3, World3s>(def, at);
+  for (int at : {40, 150, 220}) check_scene<3, World3s>(def, at);
 }
 
 TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (hull contacts, pile rest, grid)")
@@ -141,7 +141,7 @@ TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (hull contacts, pile 
 TEST_CASE("snapshot: a loaded 2D pile steps on bit for bit")
 {
   WorldDef2 def;
-  for (int at : {60, 200}) check_scene<2, World2s>(def, at);
+  for (int at : {60, 140}) check_scene<2, World2s>(def, at);
   def.body_contacts = BodyContacts::hulls;
   def.broad_phase = BroadPhase::grid;
   check_scene<2, World2s>(def, 120);

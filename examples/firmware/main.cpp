@@ -95,13 +95,11 @@ namespace {
 constexpr std::uint32_t bodies = FIRMWARE_BODIES;
 constexpr int steps = FIRMWARE_STEPS;
 constexpr statsim::Scalar dt = statsim::Scalar(1) / 60;
-// Candidate pairs per body (the broad phase pairs bounding spheres), each shape's measured peak
-// with a margin (examples/firmware/README.md): a bunny's bounding radius is over twice the height
-// it rests at, so a pile of bunnies has far more candidate pairs per body than a pile of boxes;
-// an L-shape's bounding sphere reaches far past its arms. A step reports an overflow, and this
-// program then fails.
-constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 2 ? 8 : (FIRMWARE_SHAPE == 1 ? 5 : 4)) * bodies;
-constexpr std::uint32_t pairs2 = 3 * bodies;
+// Candidate pairs per body (the broad phase pairs the collision spheres and a margin,
+// `detail::pair_radius`), each shape's measured peak with a margin of a third or more
+// (examples/firmware/README.md). A step reports an overflow, and this program then fails.
+constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 0 ? 3 : 2) * bodies;
+constexpr std::uint32_t pairs2 = 5 * bodies / 2;
 // Scenes that grow with the body count: columns of bodies four high in 3D (k x k columns, k a
 // multiple of 4) and eight high in 2D.
 constexpr std::uint32_t grid_side(std::uint32_t n, std::uint32_t height, std::uint32_t step, std::uint32_t power)
