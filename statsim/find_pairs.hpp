@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// The broad phase of a step: candidate pairs of bodies whose spheres of `pair_radius` overlap,
-/// from the hashed grid or sweep-and-prune (`broadphase.hpp`), into the world's pair buffer. Pairs with a
-/// sleeping body are found only from the awake one; two sleepers are never a pair.
+/// from the hashed grid or sweep-and-prune (`broadphase.hpp`), into the world's pair buffer.
+/// Pairs with a sleeping body are found only from the awake one; two sleepers are never a pair.
 
 #include "statsim/world_data.hpp"
 

@@ -203,8 +203,8 @@ bool has_hull(const Shape<D>& s)
 }
 
 /// How far beyond its collision sphere, as a fraction of its radius, the broad phase looks for a
-/// body's contacts. The step's passes move bodies after the broad phase (out of the ground, out of one
-/// another), and a pair they bring into touch is met in that step only if it is a candidate.
+/// body's contacts. The step's passes move bodies after the broad phase (out of the ground, out of
+/// one another), and a pair they bring into touch is met in that step only if it is a candidate.
 constexpr Scalar pair_margin = Scalar(0.1);
 
 /// The radius within which the broad phase looks for a body's contacts, m: its bounding radius
