@@ -56,7 +56,7 @@ Added<BodyId> add_body(WorldData<D>& w, const BodyDef<D>& def)
   // The slot's stream from another start in each generation (the first's is the seed's).
   const std::uint64_t start = w.def.seed + generation * std::uint64_t(0x9e3779b97f4a7c15ull);
   b.rng_state = Pcg32(start, body_stream(w.def.seed, id)).state();
-  b.shape = def.shape.index;
+  b.shape = std::uint16_t(def.shape.index & ((1u << shape_index_bits) - 1u));  // checked below shape_count
   b.state = def.asleep ? MotionState::asleep : MotionState::moving;
   b.touching = false;
   b.on_ground = false;

@@ -198,7 +198,7 @@ template <int D>
 struct SnapshotBody {
   Body<D> body;
   std::uint8_t flags, state;
-  std::uint16_t generation;
+  std::uint16_t generation, shape;  // shape: as read, before `Body::shape` keeps its low bits
 };
 
 /// Checks a body slot as `add_body` and the setters check their input: the status of the first
@@ -210,8 +210,8 @@ Status check_snapshot_body(const WorldData<D>& w, const SnapshotBody<D>& r, cons
   using Vec = typename Space<D>::Vec;
   const Body<D>& b = r.body;
   if (r.flags >= 32 || r.state > std::uint8_t(MotionState::asleep)) return Status::invalid_snapshot;
-  if (b.shape >= shape_count) return Status::invalid_shape;
-  const Shape<D>& shape = w.shapes[b.shape];
+  if (r.shape >= shape_count) return Status::invalid_shape;
+  const Shape<D>& shape = w.shapes[r.shape];
   const bool removed = (r.flags & snap_removed) != 0;
   if (r.generation > retired_generation || (r.generation == retired_generation && !removed))
     return Status::invalid_snapshot;
@@ -311,7 +311,8 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
     Body<D>& b = r.body;
     r.flags = in.u8();
     r.generation = in.u16();
-    b.shape = in.u16();
+    r.shape = in.u16();
+    b.shape = std::uint16_t(r.shape & ((1u << shape_index_bits) - 1u));  // checked below shape_count
     r.state = in.u8();
     b.rest_pose = in.u8();
     b.rng_state = in.u64();
@@ -326,14 +327,13 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
     const Status s = check_snapshot_body(w, r, def, shapes);
     if (s != Status::ok) return s;
     // Every body of a shape was added with the shape's bounding diameter taken into `widest`.
-    if (2 * w.shapes[b.shape].bounding_radius > widest) return Status::invalid_snapshot;
+    if (2 * w.shapes[r.shape].bounding_radius > widest) return Status::invalid_snapshot;
     if (!commit) continue;
     b.state = MotionState(r.state);
     b.touching = (r.flags & snap_touching) != 0;
     b.on_ground = (r.flags & snap_on_ground) != 0;
     b.pile_rest = (r.flags & snap_pile_rest) != 0;
-    b.supports = 0;
-    w.bodies[i] = b;
+    w.bodies[i] = b;  // its `supports` 0, as `r` was value-initialised
     w.slots.generation[i] = r.generation;
     if (r.flags & snap_removed) {
       ++w.slots.removed;

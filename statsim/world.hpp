@@ -383,7 +383,7 @@ class WorldCore {
 
 /// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
-/// `overflow_pairs`), `MaxShapes` shapes and `MaxImpacts` impact events per step (0: none recorded,
+/// `overflow_pairs`), `MaxShapes` shapes (at most 2,048) and `MaxImpacts` impact events per step (0: none recorded,
 /// none reported). All storage is inside the object: a large world
 /// belongs in static storage, not on the stack (10,000 bodies take about 2 MB with the default
 /// pair buffer). `Phases`: the broad phases the world keeps storage for, `automatic` (both) or
@@ -401,7 +401,8 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   static constexpr std::uint32_t max_pairs = MaxPairs;
   static constexpr std::uint32_t max_shapes = MaxShapes;
   static_assert(MaxBodies > 0 && MaxPlanes > 0 && MaxPairs > 0 && MaxShapes > 0, "capacities must be positive");
-  static_assert(MaxShapes <= 65535 && MaxPlanes < 65535, "shape and plane ids are 16-bit");
+  static_assert(MaxShapes <= 1u << shape_index_bits && MaxPlanes < 65535,
+                "a body holds its shape's index in shape_index_bits bits; plane ids are 16-bit");
   static_assert(MaxBodies <= 1u << body_index_bits, "body ids hold the slot in body_index_bits bits");
   static_assert(Phases != BroadPhase::grid, "the grid's storage holds sweep-and-prune's too: use automatic");
 

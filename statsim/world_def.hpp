@@ -69,6 +69,8 @@ struct ShapeId {
   constexpr bool operator==(const ShapeId& o) const { return index == o.index && world == o.world; }
   constexpr bool operator!=(const ShapeId& o) const { return !(*this == o); }
 };
+/// Bits of a shape's index in a body (`Body::shape`): a world holds at most 2,048 shapes.
+constexpr std::uint32_t shape_index_bits = 11;
 /// Index of a plane in its world, in order of creation.
 using PlaneId = std::uint16_t;
 
@@ -302,12 +304,16 @@ struct Body {
   Scalar slow_time;                       ///< s spent slow and touching
   Scalar rest_blend;                      ///< 0: radius is h_coll; 1: radius is h_rest of rest_pose
   Word64 rng_state;                       ///< state of the body's PCG32 stream
-  std::uint16_t shape;                    ///< index of the body's shape (`ShapeId::index`)
-  MotionState state;
-  bool touching;                          ///< touched a plane or body in the last step
-  bool on_ground;                         ///< touched a near-horizontal plane in the last step
+  // Bit-fields: they read and assign as plain fields, but cannot be bound to a reference. In 2D
+  // the shape's index and the four flags share two bytes, which makes the body 64 bytes; a 3D
+  // body is 96 bytes either way (its orientation's alignment), and whole bytes are read and
+  // written without masks.
+  std::uint16_t shape : D == 2 ? shape_index_bits : 16;  ///< index of the body's shape (`ShapeId::index`)
+  MotionState state : D == 2 ? 2 : 8;
+  bool touching : D == 2 ? 1 : 8;         ///< touched a plane or body in the last step
+  bool on_ground : D == 2 ? 1 : 8;        ///< touched a near-horizontal plane in the last step
+  bool pile_rest : D == 2 ? 1 : 8;        ///< settling on other bodies, blending to the mean h_rest (`WorldDef::pile_rest`)
   std::uint8_t rest_pose;                 ///< chosen rest pose, or `no_rest_pose`
-  bool pile_rest;                         ///< settling on other bodies, blending to the mean h_rest (`WorldDef::pile_rest`)
   /// With hull contacts, the horizontal directions (eight sectors, one bit each) from which
   /// bodies and planes held the body in the step's shock pass, all bits when one held it under
   /// its centre of mass (`detail::mark_supports`); scratch of the step, not part of the state,

@@ -100,6 +100,35 @@ int g_asserts = 0;
 void count_assert(const char*, const char*, int) { ++g_asserts; }
 }  // namespace
 
+TEST_CASE("a 2D body is 64 bytes: its shape index and four flags share two bytes, each keeps its own value")
+{
+  // The firmware's RAM per body counts one body (examples/firmware/README.md).
+  CHECK(sizeof(Body<2>) == 64);
+  CHECK(sizeof(Body<3>) == 96);
+  Body<2> b{};
+  const Body<2>& r = b;  // doctest binds its operands by reference: a const one copies a bit-field
+  b.shape = (1u << shape_index_bits) - 1;
+  CHECK(r.shape == 2047);
+  CHECK(r.state == MotionState::moving);
+  CHECK(!r.touching);
+  b.state = MotionState::asleep;
+  b.touching = true;
+  b.pile_rest = true;
+  CHECK(r.shape == 2047);
+  CHECK(r.state == MotionState::asleep);
+  CHECK(r.touching);
+  CHECK(!r.on_ground);
+  CHECK(r.pile_rest);
+  b.shape = 0;
+  b.on_ground = true;
+  CHECK(r.state == MotionState::asleep);
+  CHECK(r.touching);
+  CHECK(r.on_ground);
+  CHECK(r.shape == 0);
+  CHECK(r.rest_pose == 0);
+  CHECK(r.supports == 0);
+}
+
 TEST_CASE("find_body checks the id; body() past the end stays inside the world")
 {
   auto w = std::make_unique<World3<4>>();

@@ -294,6 +294,8 @@ TEST_CASE("snapshot: refused loads leave the world as it was")
         {body + 15, two_bits, Status::non_unit_quaternion},
         {body + 3, 0x00ff0000u | get32(good, body + 3), Status::invalid_snapshot},  // motion state 255
         {body + 3, (0xffff0000u & get32(good, body + 3)) | 9u, Status::invalid_shape},  // shape 9
+        // Shape 2049, whose low `shape_index_bits` (11) name shape 1: `Body::shape` keeps only those.
+        {body + 3, (0xffff0000u & get32(good, body + 3)) | 2049u, Status::invalid_shape},
         {sweep_axis_offset<3>(), 5, Status::invalid_parameter},
         {order, get32(good, order + 4), Status::invalid_snapshot},  // a slot twice in the sweep order
         {order, entries, Status::invalid_snapshot},                 // a slot past the end
