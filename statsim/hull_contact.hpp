@@ -200,6 +200,10 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
 {
   using Vec = typename Space<D>::Vec;
   constexpr std::uint32_t fv = face_values(D);
+  // No support exceeds the bounding radius (`add_shape` makes it at least the support map's
+  // ceiling; 1e-4 covers the rounding of a lookup): a pair farther apart than packing times the
+  // sum is apart without a lookup, as about a quarter of a pile's candidate pairs are.
+  if (!(dist < packing * (sa.bounding_radius + sb.bounding_radius) * Scalar(1.0001))) return no_witness;
   // Along e itself first: the least distance is at most this one, so a pair apart along e is
   // apart (the faces can only bring the distance down).
   const Vec ea = to_body(a.orientation, e), eb = to_body(b.orientation, e);
