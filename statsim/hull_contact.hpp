@@ -200,10 +200,6 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
 {
   using Vec = typename Space<D>::Vec;
   constexpr std::uint32_t fv = face_values(D);
-  // No support exceeds the bounding radius (`add_shape` makes it at least the support map's
-  // ceiling; 1e-4 covers the rounding of a lookup): a pair farther apart than packing times the
-  // sum is apart without a lookup, as about a quarter of a pile's candidate pairs are.
-  if (!(dist < packing * (sa.bounding_radius + sb.bounding_radius) * Scalar(1.0001))) return no_witness;
   // Along e itself first: the least distance is at most this one, so a pair apart along e is
   // apart (the faces can only bring the distance down).
   const Vec ea = to_body(a.orientation, e), eb = to_body(b.orientation, e);
@@ -292,8 +288,16 @@ void search_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, co
 {
   const Scalar pa = sa.statistical ? sa.largest_packing : Scalar(1);
   const Scalar pb = sb.statistical ? sb.largest_packing : Scalar(1);
-  pair.witness =
-      find_hull_witness(sa, a, sb, b, e, dist, pa > pb ? pa : pb, pair_packing(sa, sb, a.shape == b.shape, e)) & 0xffu;
+  const Scalar packing = pa > pb ? pa : pb;
+  // A world's shapes support no farther than their bounding radius (`add_shape` makes it at least
+  // the support map's ceiling; 1e-4 covers a lookup's rounding): a pair farther apart than the
+  // packing times their sum is apart without a lookup, as about a quarter of a pile's pairs are.
+  // (Not in `find_hull_witness`: the gatherers call it on shapes that no world set up.)
+  if (!(dist < packing * (sa.bounding_radius + sb.bounding_radius) * Scalar(1.0001))) {
+    pair.witness = no_witness;
+    return;
+  }
+  pair.witness = find_hull_witness(sa, a, sb, b, e, dist, packing, pair_packing(sa, sb, a.shape == b.shape, e)) & 0xffu;
 }
 
 /// Whether the pair touches and how: at their collision spheres, or (`BodyContacts::hulls`,
