@@ -291,7 +291,7 @@ void search_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, co
   const Scalar packing = pa > pb ? pa : pb;
   // A world's shapes support no farther than their bounding radius (`add_shape` makes it at least
   // the support map's ceiling; 1e-4 covers a lookup's rounding): a pair farther apart than the
-  // packing times their sum is apart without a lookup, as about a quarter of a pile's pairs are.
+  // packing times their sum is apart without a lookup (tools/bench/README.md: many pile pairs are).
   // (Not in `find_hull_witness`: the gatherers call it on shapes that no world set up.)
   if (!(dist < packing * (sa.bounding_radius + sb.bounding_radius) * Scalar(1.0001))) {
     pair.witness = no_witness;

@@ -383,10 +383,10 @@ class WorldCore {
 
 /// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports
-/// `overflow_pairs`), `MaxShapes` shapes (at most 2,048) and `MaxImpacts` impact events per step (0: none recorded,
-/// none reported). All storage is inside the object: a large world
-/// belongs in static storage, not on the stack (10,000 bodies take about 2 MB with the default
-/// pair buffer). `Phases`: the broad phases the world keeps storage for, `automatic` (both) or
+/// `overflow_pairs`), `MaxShapes` shapes (at most 2,048) and `MaxImpacts` impact events per step
+/// (0: none recorded, none reported). All storage is inside the object: a large world belongs in
+/// static storage, not on the stack (10,000 bodies take about 2 MB with the default pair
+/// buffer). `Phases`: the broad phases the world keeps storage for, `automatic` (both) or
 /// `sweep_and_prune` (its entries only, for small worlds short of memory: `automatic` then
 /// always sweeps, and `WorldDef::broad_phase = grid` is refused).
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
