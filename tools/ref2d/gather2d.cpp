@@ -13,6 +13,7 @@
 
 #include "common/support_map.hpp"
 #include "statsim/hull_contact.hpp"
+#include "statsim/shape_setup.hpp"
 #include "statsim/response.hpp"
 #include "statsim/statistical.hpp"
 

@@ -9,6 +9,7 @@
 #include "ref3d/pairs.hpp"
 #include "ref3d/sampling.hpp"
 #include "statsim/hull_contact.hpp"
+#include "statsim/shape_setup.hpp"
 #include "statsim/response.hpp"
 #include "statsim/signature.hpp"
 #include "statsim/statistical.hpp"
