@@ -68,6 +68,24 @@
 #error "STATSIM_WORKERS must be 0 or 1"
 #endif
 
+/// 1: a world with hull contacts (`BodyContacts::hulls`) keeps, for each pair the impact pass
+/// found touching at a face, the contact's normal and reach (`detail::PairHull`, 16 bytes in 3D
+/// and 12 in 2D, room for 2 per body, at most `MaxPairs`), so that the later passes of the step
+/// read them instead of rotating the face and reading the support map again; touching pairs
+/// beyond the room are found afresh. The results are the same bit for bit either way. 0: no such storage; every pass finds the contacts afresh. Default: 1 on an
+/// operating system (Unix, macOS, Windows), 0 elsewhere (bare metal, WebAssembly), where the
+/// bytes count for more than the time.
+#ifndef STATSIM_HULL_CACHE
+#if (defined(__unix__) || defined(__APPLE__) || defined(_WIN32)) && !defined(__EMSCRIPTEN__)
+#define STATSIM_HULL_CACHE 1
+#else
+#define STATSIM_HULL_CACHE 0
+#endif
+#endif
+#if STATSIM_HULL_CACHE != 0 && STATSIM_HULL_CACHE != 1
+#error "STATSIM_HULL_CACHE must be 0 or 1"
+#endif
+
 /// Version of the layout of generated signature tables. A table generated for another version
 /// fails to compile against this runtime (the tables static_assert on it).
 #define STATSIM_TABLE_FORMAT_VERSION 2

@@ -254,20 +254,27 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
 /// hull contact afresh unless `search_witnesses_first` has). For each touching pair it calls
 /// `resolve(a, b, contact, slop, reach)`,
 /// which returns false when neither body can move, and else marks both touching. With
-/// `compact`, touching pairs move to the front of the buffer, in their order. Returns the
-/// number of touching pairs.
+/// `compact`, touching pairs move to the front of the buffer, in their order. With `keep`, each
+/// pair's face contact is kept for the later passes (`WorldData::pair_hulls`, at the pair's new
+/// place), which read it. Returns the number of touching pairs.
 template <int D, class Resolve>
-std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bool compact, Resolve&& resolve,
-                            bool fresh = true)
+std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bool compact, bool keep,
+                            Resolve&& resolve, bool fresh = true)
 {
   std::uint32_t touching = 0;
+  PairHull<D> found{Space<D>::Vec::Zero(), 0};
   for (std::uint32_t k = 0; k < count; ++k) {
     Body<D>& a = w.bodies[w.pairs[k].a];
     Body<D>& b = w.bodies[w.pairs[k].b];
     Contact<D> c;
     Scalar reach, slop;
-    if (!body_contact(w, a, b, w.pairs[k], fresh && !grown, grown ? contact_slop : Scalar(0), c, reach, slop)) continue;
+    // A compacted pair's entry goes where the pair goes: to `touching`, if it touches.
+    const std::uint32_t slot = keep && compact ? touching : k;
+    PairHull<D>* kept = STATSIM_HULL_CACHE && slot < w.max_pair_hulls ? (keep && compact ? &found : &w.pair_hulls[k]) : nullptr;
+    if (!body_contact(w, a, b, w.pairs[k], fresh && !grown, grown ? contact_slop : Scalar(0), c, reach, slop, kept, keep))
+      continue;
     if (compact) std::swap(w.pairs[touching], w.pairs[k]);
+    if (kept == &found) w.pair_hulls[touching] = found;
     ++touching;
     if (!resolve(a, b, c, slop, reach)) continue;
     a.touching = true;
@@ -328,8 +335,8 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
       ++ctx.changes;
   });
   const bool searched = search_witnesses_first(w);
-  ctx.touching = pair_contacts(w, w.pair_count, false, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c,
-                                                                 Scalar slop, Scalar reach) {
+  ctx.touching = pair_contacts(w, w.pair_count, false, true, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c,
+                                                                       Scalar slop, Scalar reach) {
     const Vec& n = c.normal;
     const bool a_asleep = a.state == MotionState::asleep;
     const bool b_asleep = b.state == MotionState::asleep;
@@ -360,7 +367,7 @@ template <int D>
 std::uint32_t support_pass(WorldData<D>& w, StepContext& ctx)
 {
   ctx.changes = 0;
-  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar, Scalar) {
+  pair_contacts(w, ctx.touching, true, false, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar, Scalar) {
     Scalar ima, imb;
     if (inverse_masses(a, b, c.normal, false, ima, imb) <= 0) return false;
     if (particle_pair(w, a, b, c.normal, ima, imb, no_bounce)) ++ctx.changes;
@@ -404,7 +411,9 @@ std::uint32_t shock_pass(WorldData<D>& w, StepContext& ctx)
       w.bodies[w.pairs[k].a].supports = 0;
       w.bodies[w.pairs[k].b].supports = 0;
     }
-  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop, Scalar reach) {
+  // The sort moved the pairs away from their kept contacts: the pass keeps them afresh.
+  pair_contacts(w, ctx.touching, true, false, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop,
+                                                        Scalar reach) {
     // Marked before the correction moves the pair: where the step's passes left it.
     if (tipping && mark_supports(w, a, b, c.normal, gravity_unit)) overhangs = true;
     Scalar ima, imb;
@@ -426,7 +435,7 @@ template <int D>
 std::uint32_t position_pass(WorldData<D>& w, StepContext& ctx)
 {
   ctx.moves = 0;
-  pair_contacts(w, ctx.touching, true, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop, Scalar reach) {
+  pair_contacts(w, ctx.touching, true, false, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop, Scalar reach) {
     Scalar ima, imb;
     const Scalar ims = inverse_masses(a, b, c.normal, true, ima, imb);
     if (ims <= 0) return false;

@@ -303,31 +303,45 @@ void search_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, co
 /// both shapes with a hull) along a hull candidate, searched afresh when `fresh` (the impact
 /// pass) and else the one the impact pass found. `slop_fraction`: spheres grown by this fraction
 /// of the reach. Fills the contact and the reach (separation along the normal at which they
-/// touch, m).
+/// touch, m). `kept` (may be null): with `keep`, receives the pair's face contact (reach 0 for
+/// none); without, a face contact kept earlier in the step, used as found (`PairHull`).
 template <int D>
 bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, bool fresh, Scalar slop_fraction,
-                  Contact<D>& c, Scalar& reach, Scalar& slop)
+                  Contact<D>& c, Scalar& reach, Scalar& slop, PairHull<D>* kept = nullptr, bool keep = false)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& sa = w.shapes[a.shape];
   const Shape<D>& sb = w.shapes[b.shape];
-  if (!hull_pair(w, a, b)) {
+  if (STATSIM_HULL_CACHE && kept && keep) kept->reach = 0;
+  const bool known = STATSIM_HULL_CACHE && kept && !keep && kept->reach > 0;
+  if (!known && !hull_pair(w, a, b)) {
     reach = a.radius + b.radius;
     slop = reach * slop_fraction;
     return sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c);
   }
   const Vec d = b.position - a.position;
-  Scalar dist;
-  Vec e;
-  if (!centre_line(sa, sb, d, dist, e)) return false;
-  if (fresh) search_witness(sa, a, sb, b, e, dist, pair);
-  if (pair.witness == no_witness) return false;
-  const HullCandidate<D> h = hull_candidate(sa, a, sb, b, e, pair.witness);
-  reach = (pair.witness == 0 ? pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
+  Vec normal;
+  if (known) {
+    // `centre_line`'s test, without the line: a face's contact does not depend on it.
+    const Scalar bound = sa.bounding_radius + sb.bounding_radius;
+    if (!(d.squaredNorm() < bound * bound)) return false;
+    normal = kept->normal;
+    reach = kept->reach;
+  } else {
+    Scalar dist;
+    Vec e;
+    if (!centre_line(sa, sb, d, dist, e)) return false;
+    if (fresh) search_witness(sa, a, sb, b, e, dist, pair);
+    if (pair.witness == no_witness) return false;
+    const HullCandidate<D> h = hull_candidate(sa, a, sb, b, e, pair.witness);
+    normal = h.normal;
+    reach = (pair.witness == 0 ? pair_packing(sa, sb, a.shape == b.shape, e) : h.packing) * h.reach;
+    if (STATSIM_HULL_CACHE && kept && keep && pair.witness != 0) *kept = PairHull<D>{normal, reach};
+  }
   slop = reach * slop_fraction;
-  const Scalar depth = reach + slop - d.dot(h.normal);
+  const Scalar depth = reach + slop - d.dot(normal);
   if (!(depth > 0)) return false;
-  c.normal = h.normal;
+  c.normal = normal;
   c.depth = depth;
   return true;
 }

@@ -258,7 +258,9 @@ void tip_unsupported(WorldData<D>& w, std::uint32_t touching, const typename Spa
     Body<D>& b = w.bodies[w.pairs[k].b];
     Contact<D> c;
     Scalar reach, pair_slop;
-    if (!body_contact(w, a, b, w.pairs[k], false, slop_fraction, c, reach, pair_slop)) continue;
+    if (!body_contact(w, a, b, w.pairs[k], false, slop_fraction, c, reach, pair_slop,
+                      STATSIM_HULL_CACHE && k < w.max_pair_hulls ? &w.pair_hulls[k] : nullptr))
+      continue;
     if (!hull_pair(w, a, b)) continue;
     Body<D>*lo, *up;
     Vec n;

@@ -20,8 +20,8 @@
 ///  5. shock pass: contacts from the bottom up, the lower body immovable; overlaps between bodies
 ///     are corrected here, softly (`allowed_overlap`, `overlap_correction`), then again in
 ///     `position_iterations` passes that only move bodies;
-///  6. motion state: moving, settling (slow and touching), asleep (slow for `sleep_time`)
-///     (rest_and_sleep.hpp).
+///  6. motion state (rest_and_sleep.hpp): moving, settling (slow and touching), asleep (slow for
+///     `sleep_time`).
 /// Sleeping bodies are not integrated and act as static supports until hit harder than
 /// `wake_speed` (or, with hull contacts, pressed deep: `detail::hull_wake_overlap`).
 
@@ -188,8 +188,7 @@ class WorldCore {
   Status sleep(BodyId id) { return detail::sleep_body(w_, id); }
 
   /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` (not
-  /// `out_of_range`) if dt is not finite and positive or exceeds `limits::time_step` (1 s); then
-  /// nothing changes.
+  /// `out_of_range`), changing nothing, if dt is not finite and positive or above `limits::time_step`.
   /// Overflow of the pair buffer is reported in the result, never silent.
   StepResult step(Scalar dt)
   {
@@ -341,6 +340,8 @@ class WorldCore {
     std::uint16_t* generations;
     std::uint32_t* free_slots;
     bool grid_storage;  ///< `broad_phase` holds the grid too
+    detail::PairHull<D>* pair_hulls;  ///< `max_pair_hulls` of them (`STATSIM_HULL_CACHE`)
+    std::uint32_t max_pair_hulls;
   };
 
   WorldCore(const Storage& s, const WorldDef<D>& def)
@@ -368,6 +369,8 @@ class WorldCore {
     w_.slots.generation = s.generations;
     w_.slots.free = s.free_slots;
     w_.grid_storage = s.grid_storage;
+    w_.pair_hulls = s.max_pair_hulls > 0 ? s.pair_hulls : nullptr;  // std::array<T, 0>::data() may be anything
+    w_.max_pair_hulls = s.max_pair_hulls;
     construction_status_ = configure(def);
     if (construction_status_ == Status::ok && detail::float_contraction()) construction_status_ = Status::float_contraction;
   }
@@ -410,16 +413,14 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
   /// `construction_status()` says why.
   explicit World(const WorldDef<D>& def = {})
       : StorageBase(),
-        WorldCore<D>(typename WorldCore<D>::Storage{StorageBase::body_store.data(),
-                                                     StorageBase::broad_phase_store.data(),
-                                                     StorageBase::pair_store.data(), StorageBase::plane_store.data(),
-                                                     StorageBase::shape_store.data(),
-                                                     StorageBase::awake_store.data(),
-                                                     StorageBase::flagged_store.data(),
-                                                     StorageBase::rolled_store.data(), MaxBodies, MaxPairs, MaxPlanes,
-                                                     MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
-                                                     StorageBase::generation_store.data(),
-                                                     StorageBase::free_store.data(), StorageBase::grid},
+        WorldCore<D>(typename WorldCore<D>::Storage{
+                         StorageBase::body_store.data(), StorageBase::broad_phase_store.data(),
+                         StorageBase::pair_store.data(), StorageBase::plane_store.data(),
+                         StorageBase::shape_store.data(), StorageBase::awake_store.data(),
+                         StorageBase::flagged_store.data(), StorageBase::rolled_store.data(), MaxBodies, MaxPairs,
+                         MaxPlanes, MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
+                         StorageBase::generation_store.data(), StorageBase::free_store.data(), StorageBase::grid,
+                         StorageBase::pair_hull_store.data(), std::uint32_t(StorageBase::pair_hull_store.size())},
                      def)
   {
   }

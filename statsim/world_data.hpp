@@ -77,6 +77,18 @@ struct QueryIndex {
   Scalar drift = 0;
 };
 
+/// A touching pair's hull contact at a face (`Pair::witness` >= 1, `STATSIM_HULL_CACHE`): its
+/// normal (from a to b) and the separation of the centres along it at which the pair touches,
+/// packing included (m). Both depend on the two orientations alone, which no pass of a step
+/// changes, so the passes after the one that found them read them here (`body_contact`).
+/// `reach` 0: none kept (a contact along the line of centres, whose normal moves with the
+/// bodies, or a pair of collision spheres).
+template <int D>
+struct PairHull {
+  typename Space<D>::Vec normal;
+  Scalar reach;
+};
+
 /// A world's storage (owned by `World<>`), counts and parameters: what every phase reads.
 template <int D>
 struct WorldData {
@@ -124,6 +136,11 @@ struct WorldData {
   WorldDef<D> def{};
   BodySlots slots{};  ///< what names the body in each slot (`remove_body`)
   QueryIndex index{};  ///< the broad phase's records as the queries see them
+  /// The touching pairs' hull contacts, entry k for pair k, as the impact pass left them and,
+  /// after the shock pass sorted the pairs, as it found them; `max_pair_hulls` 0 without them
+  /// (`STATSIM_HULL_CACHE`). Scratch of the step, not part of the state.
+  PairHull<D>* pair_hulls = nullptr;
+  std::uint32_t max_pair_hulls = 0;
 };
 
 /// Records that body `i` was given a new place between steps: its broad phase record (if it has

@@ -1,6 +1,7 @@
 // Body-body contacts at the shapes' hulls (statsim/hull_contact.hpp, BodyContacts::hulls) with the
 // committed tables' body-body data: the support map against the closed form, stacks that hold
 // their true height, and piles that end asleep, above the ground and without overlaps.
+#include "statsim/snapshot.hpp"
 #include "statsim/statsim.hpp"
 #include "tables/box.hpp"
 #include "tables/lshape.hpp"
@@ -48,6 +49,51 @@ void pile_state(const World& w, Scalar& overlap, Scalar& lowest)
       const Scalar f = (reach - d.dot(h.normal)) / reach;
       overlap = f > overlap ? f : overlap;
     }
+  }
+}
+
+// Steps three copies of a pile of two shapes with hull contacts: with room for every touching
+// pair's face contact (`detail::PairHull`, kept by the impact and shock passes for the passes
+// after them), with room for `few` (the pairs beyond are found afresh in every pass), and with
+// none. The state hashes must agree after every step; `kept` counts the entries the first world
+// held after its steps, to show that it used them.
+template <int D, class World>
+void compare_kept_contacts(const SignatureView<D>& s0, const SignatureView<D>& s1, int steps, std::uint32_t few,
+                           std::uint64_t& kept)
+{
+  using Vec = typename Space<D>::Vec;
+  WorldDef<D> def;
+  def.body_contacts = BodyContacts::hulls;
+  std::unique_ptr<World> w[3] = {std::make_unique<World>(def), std::make_unique<World>(def), std::make_unique<World>(def)};
+  REQUIRE(detail::SnapshotAccess::data<D>(*w[0]).max_pair_hulls > few);
+  detail::SnapshotAccess::data<D>(*w[1]).max_pair_hulls = few;
+  detail::SnapshotAccess::data<D>(*w[2]).max_pair_hulls = 0;
+  for (auto& world : w) {
+    const ShapeId shapes[] = {world->add_shape(s0).id, world->add_shape(s1).id};
+    REQUIRE(world->add_plane(Vec::Unit(Space<D>::up_axis), 0).status == Status::ok);
+    Pcg32 rng(7, 1);
+    for (std::uint32_t i = 0; i < World::max_bodies; ++i) {
+      BodyDef<D> b;
+      b.shape = shapes[i % 2];
+      b.mass = 1;
+      // As the piles above: 3D layers of 4 x 4 boxes and L-shapes (0.2 m), 2D rows of 8 (1 m).
+      if constexpr (D == 3) {
+        b.position = Vector3(Scalar(0.25) * Scalar(i % 4), Scalar(0.25) * Scalar((i / 4) % 4), Scalar(0.3) + Scalar(0.3) * Scalar(i / 16));
+        b.orientation = Quaternion(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f).normalized();
+      } else {
+        b.position = Vector2(Scalar(1.6) * Scalar(i % 8) - 6, Scalar(1) + Scalar(1.6) * Scalar(i / 8));
+        b.orientation = Rot2::from_angle(Scalar(6.283185) * rng.uniform());
+      }
+      REQUIRE(world->add_body(b).status == Status::ok);
+    }
+  }
+  kept = 0;
+  for (int s = 0; s < steps; ++s) {
+    for (auto& world : w) REQUIRE(world->step(Scalar(1) / 60).ok());
+    const detail::WorldData<D>& data = detail::SnapshotAccess::data<D>(*w[0]);
+    for (std::uint32_t k = 0; k < data.touching_pairs && k < data.max_pair_hulls; ++k) kept += data.pair_hulls[k].reach > 0;
+    REQUIRE(w[1]->state_hash() == w[0]->state_hash());
+    REQUIRE(w[2]->state_hash() == w[0]->state_hash());
   }
 }
 
@@ -336,4 +382,13 @@ TEST_CASE("hull contacts: the distance at which two L-shapes touch changes conti
     }
     CHECK(jump < Scalar(3) * shapes[0].bounding_radius * turn);
   }
+}
+
+TEST_CASE("hull contacts: the face contacts kept between a step's passes give the bits of contacts found afresh (3D and 2D)")
+{
+  std::uint64_t kept = 0;
+  compare_kept_contacts<3, World3<64>>(tables::box.view(), tables::lshape.view(), 400, 5, kept);
+  CHECK(kept > 1000);
+  compare_kept_contacts<2, World2<64>>(tables::square2d.view(), tables::lshape2d.view(), 400, 5, kept);
+  CHECK(kept > 1000);
 }
