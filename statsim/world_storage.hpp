@@ -24,7 +24,8 @@ struct WorldStorage {
   std::array<Body<D>, MaxBodies> body_store;
   alignas(16) std::array<unsigned char, broad_phase_bytes> broad_phase_store;
   std::array<Pair, MaxPairs> pair_store;
-  // Piles touch at about 1.2 (2D) to 2.2 (3D) pairs per body: the pairs beyond are found afresh.
+  // Room for the touching pairs of a pile (tools/bench/README.md counts them); beyond it, contacts
+  // are found afresh in every pass.
   static constexpr std::uint32_t pair_hulls = 2 * MaxBodies < MaxPairs ? 2 * MaxBodies : MaxPairs;
   std::array<PairHull<D>, STATSIM_HULL_CACHE ? pair_hulls : 0> pair_hull_store;
   std::array<Plane<D>, MaxPlanes> plane_store;

@@ -52,14 +52,15 @@ void pile_state(const World& w, Scalar& overlap, Scalar& lowest)
   }
 }
 
-// Steps three copies of a pile of two shapes with hull contacts: with room for every touching
+// Steps three copies of a pile of two shapes and plain spheres (radius `sphere`, m; they touch
+// the others' faces) with hull contacts: with room for every touching
 // pair's face contact (`detail::PairHull`, kept by the impact and shock passes for the passes
 // after them), with room for `few` (the pairs beyond are found afresh in every pass), and with
 // none. The state hashes must agree after every step; `kept` counts the entries the first world
 // held after its steps, to show that it used them.
 template <int D, class World>
-void compare_kept_contacts(const SignatureView<D>& s0, const SignatureView<D>& s1, int steps, std::uint32_t few,
-                           std::uint64_t& kept)
+void compare_kept_contacts(const SignatureView<D>& s0, const SignatureView<D>& s1, Scalar sphere, int steps,
+                           std::uint32_t few, std::uint64_t& kept)
 {
   using Vec = typename Space<D>::Vec;
   WorldDef<D> def;
@@ -69,12 +70,14 @@ void compare_kept_contacts(const SignatureView<D>& s0, const SignatureView<D>& s
   detail::SnapshotAccess::data<D>(*w[1]).max_pair_hulls = few;
   detail::SnapshotAccess::data<D>(*w[2]).max_pair_hulls = 0;
   for (auto& world : w) {
-    const ShapeId shapes[] = {world->add_shape(s0).id, world->add_shape(s1).id};
+    ShapeDef ball;
+    ball.radius = sphere;
+    const ShapeId shapes[] = {world->add_shape(s0).id, world->add_shape(s1).id, world->add_shape(ball).id};
     REQUIRE(world->add_plane(Vec::Unit(Space<D>::up_axis), 0).status == Status::ok);
     Pcg32 rng(7, 1);
     for (std::uint32_t i = 0; i < World::max_bodies; ++i) {
       BodyDef<D> b;
-      b.shape = shapes[i % 2];
+      b.shape = shapes[i % 3];
       b.mass = 1;
       // As the piles above: 3D layers of 4 x 4 boxes and L-shapes (0.2 m), 2D rows of 8 (1 m).
       if constexpr (D == 3) {
@@ -387,8 +390,8 @@ TEST_CASE("hull contacts: the distance at which two L-shapes touch changes conti
 TEST_CASE("hull contacts: the face contacts kept between a step's passes give the bits of contacts found afresh (3D and 2D)")
 {
   std::uint64_t kept = 0;
-  compare_kept_contacts<3, World3<64>>(tables::box.view(), tables::lshape.view(), 400, 5, kept);
+  compare_kept_contacts<3, World3<64>>(tables::box.view(), tables::lshape.view(), Scalar(0.1), 400, 5, kept);
   CHECK(kept > 1000);
-  compare_kept_contacts<2, World2<64>>(tables::square2d.view(), tables::lshape2d.view(), 400, 5, kept);
+  compare_kept_contacts<2, World2<64>>(tables::square2d.view(), tables::lshape2d.view(), Scalar(0.5), 400, 5, kept);
   CHECK(kept > 1000);
 }
