@@ -72,9 +72,9 @@
 /// found touching at a face, the contact's normal and reach (`detail::PairHull`, 16 bytes in 3D
 /// and 12 in 2D, room for 2 per body, at most `MaxPairs`), so that the later passes of the step
 /// read them instead of rotating the face and reading the support map again; touching pairs
-/// beyond the room are found afresh. The results are the same bit for bit either way. 0: no such storage; every pass finds the contacts afresh. Default: 1 on an
-/// operating system (Unix, macOS, Windows), 0 elsewhere (bare metal, WebAssembly), where the
-/// bytes count for more than the time.
+/// beyond the room are found afresh. The results are the same bit for bit either way. 0: no such
+/// storage; every pass finds the contacts afresh. Default: 1 on an operating system (Unix, macOS,
+/// Windows), 0 elsewhere (bare metal, WebAssembly), where the bytes count for more than the time.
 #ifndef STATSIM_HULL_CACHE
 #if (defined(__unix__) || defined(__APPLE__) || defined(_WIN32)) && !defined(__EMSCRIPTEN__)
 #define STATSIM_HULL_CACHE 1
