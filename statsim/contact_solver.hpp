@@ -262,19 +262,18 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
                             Resolve&& resolve, bool fresh = true)
 {
   std::uint32_t touching = 0;
-  PairHull<D> found{Space<D>::Vec::Zero(), 0};
   for (std::uint32_t k = 0; k < count; ++k) {
     Body<D>& a = w.bodies[w.pairs[k].a];
     Body<D>& b = w.bodies[w.pairs[k].b];
     Contact<D> c;
     Scalar reach, slop;
-    // A compacted pair's entry goes where the pair goes: to `touching`, if it touches.
-    const std::uint32_t slot = keep && compact ? touching : k;
-    PairHull<D>* kept = STATSIM_HULL_CACHE && slot < w.max_pair_hulls ? (keep && compact ? &found : &w.pair_hulls[k]) : nullptr;
+    // A compacted pair's entry goes where the pair will go; a pair that does not touch leaves
+    // that place to the next.
+    const std::uint32_t slot = compact ? touching : k;
+    PairHull<D>* kept = STATSIM_HULL_CACHE && slot < w.max_pair_hulls ? &w.pair_hulls[slot] : nullptr;
     if (!body_contact(w, a, b, w.pairs[k], fresh && !grown, grown ? contact_slop : Scalar(0), c, reach, slop, kept, keep))
       continue;
     if (compact) std::swap(w.pairs[touching], w.pairs[k]);
-    if (kept == &found) w.pair_hulls[touching] = found;
     ++touching;
     if (!resolve(a, b, c, slop, reach)) continue;
     a.touching = true;
