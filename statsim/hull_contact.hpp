@@ -61,23 +61,22 @@ inline void support_cell(Scalar a, std::uint32_t size, std::uint32_t& i, Scalar&
 /// coordinates of u / |u_m|, times |u_m|.
 inline Scalar support_along(const ContactView<3>& c, const Vector3& u)
 {
-  int m = 0;
-  Scalar um = std::fabs(u[0]);
-  if (std::fabs(u[1]) > um) {
-    m = 1;
-    um = std::fabs(u[1]);
-  }
-  if (std::fabs(u[2]) > um) {
-    m = 2;
-    um = std::fabs(u[2]);
-  }
+  // The axis is picked by arithmetic on the comparisons, not by branches: over a step's pairs
+  // it is random, and a mispredicted branch costs more than the whole selection.
+  const Scalar a[3] = {std::fabs(u[0]), std::fabs(u[1]), std::fabs(u[2])};
+  const std::uint32_t y = a[1] > a[0] ? 1u : 0u;
+  const std::uint32_t z = a[2] > a[y] ? 1u : 0u;
+  const std::uint32_t m = z * 2u + (1u - z) * y;
+  const Scalar um = a[m];
   if (!(um > 0)) return 0;
+  static constexpr std::uint8_t next_axis[3] = {1, 2, 0}, last_axis[3] = {2, 0, 1};
+  const Scalar next = u[next_axis[m]], last = u[last_axis[m]];
   const std::uint32_t s = c.support_size;
-  const std::uint32_t face = std::uint32_t(2 * m) + (u[m] < 0 ? 1u : 0u);
+  const std::uint32_t face = 2 * m + (u[m] < 0 ? 1u : 0u);
   std::uint32_t i, j;
   Scalar t, w;
-  support_cell(u[(m + 1) % 3] / um, s, i, t);
-  support_cell(u[(m + 2) % 3] / um, s, j, w);
+  support_cell(next / um, s, i, t);
+  support_cell(last / um, s, j, w);
   const std::uint32_t k = (face * s + i) * s + j;
   const ValuesView& v = c.support;
   const Scalar h = (1 - t) * ((1 - w) * v[k] + w * v[k + 1]) + t * ((1 - w) * v[k + s] + w * v[k + s + 1]);
@@ -182,6 +181,31 @@ Scalar largest_packing(const Shape<D>& s)
   return p;
 }
 
+/// The faces of shape `s` (its first `count`) that may beat the least distance `best` found so
+/// far, as bits: face i with unit normal f_i (body frame) has cosine c_i = sign f_i.u > 0 with
+/// the line of centres u (body frame; sign -1 for the second body, whose faces point back
+/// along it) and p_i (o_i + floor) < best c_i, floor the least support of the other shape.
+/// Fills `cosine` for the faces set. The tests are gathered before any face is read further
+/// because their outcomes follow no pattern a branch predictor could learn; `best` only falls
+/// while the faces are read, so a face not set here could not have beaten it later.
+template <int D>
+std::uint32_t face_mask(const Shape<D>& s, std::uint32_t count, const typename Space<D>::Vec& u, Scalar sign,
+                        Scalar floor, Scalar best, bool packed, Scalar* cosine)
+{
+  using Vec = typename Space<D>::Vec;
+  constexpr std::uint32_t fv = face_values(D);
+  const ContactView<D>& v = s.signature.contact;
+  std::uint32_t bits = 0;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const Scalar* f = v.faces + i * fv;
+    const Scalar c = sign * Vec(Eigen::Map<const Vec>(f)).dot(u);
+    const Scalar p = packed ? f[D + 1] : Scalar(1);
+    cosine[i] = c;
+    bits |= std::uint32_t((c > 0) & (p * (f[D] * v.offset_scale + floor) < best * c)) << i;
+  }
+  return bits;
+}
+
 /// The hull contact of a pair whose centres are `d` apart (d = c_b - c_a, |d| = `dist` > 0,
 /// e = d / dist): the candidate with the least packed distance along e, p_k d_k(e), where
 /// `line_packing` > 0 is the ratio along e itself (`pair_packing`), or with `line_packing` = 0
@@ -214,31 +238,46 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
   const Scalar floor_b = sb.statistical ? sb.support_floor : sb.radius;
   const std::uint32_t ka = sa.statistical ? sa.signature.contact.face_count : 0u;
   const std::uint32_t kb = sb.statistical ? sb.signature.contact.face_count : 0u;
-  for (std::uint32_t i = 0; i < ka; ++i) {
+  // Face i of a, whose cosine with e is c.
+  const auto face_of_a = [&](std::uint32_t i, Scalar c) {
     const Scalar* f = sa.signature.contact.faces + i * fv;
-    const Scalar c = Vec(Eigen::Map<const Vec>(f)).dot(ea);
     const Scalar offset = f[D] * sa.signature.contact.offset_scale;
     const Scalar pf = packed ? f[D + 1] : Scalar(1);
-    if (!(c > 0) || !(pf * (offset + floor_b) < best * c)) continue;
+    if (!(c > 0) || !(pf * (offset + floor_b) < best * c)) return;
     const Vec n = to_world(a.orientation, Vec(Eigen::Map<const Vec>(f)));
     const Scalar along = pf * ((offset + shape_support(sb, to_body(b.orientation, Vec(-n)))) / c);
     if (!(along > best)) {
       best = along;
       witness = 1 + i;
     }
-  }
-  for (std::uint32_t i = 0; i < kb; ++i) {
+  };
+  // Face i of b, whose cosine with -e is c.
+  const auto face_of_b = [&](std::uint32_t i, Scalar c) {
     const Scalar* g = sb.signature.contact.faces + i * fv;
-    const Scalar c = -Vec(Eigen::Map<const Vec>(g)).dot(eb);
     const Scalar offset = g[D] * sb.signature.contact.offset_scale;
     const Scalar pg = packed ? g[D + 1] : Scalar(1);
-    if (!(c > 0) || !(pg * (offset + floor_a) < best * c)) continue;
+    if (!(c > 0) || !(pg * (offset + floor_a) < best * c)) return;
     const Vec n = -to_world(b.orientation, Vec(Eigen::Map<const Vec>(g)));
     const Scalar along = pg * ((shape_support(sa, to_body(a.orientation, n)) + offset) / c);
     if (!(along > best)) {
       best = along;
       witness = 1 + ka + i;
     }
+  };
+  if constexpr (D == 3) {
+    // A 3D pile's pairs meet at any angle, so which faces pass is random (`face_mask`); a 2D
+    // pile's faces pass in patterns that branches predict, and the mask costs more there
+    // (tools/bench/README.md).
+    Scalar cosine[max_contact_faces];
+    for (std::uint32_t bits = face_mask(sa, ka, ea, Scalar(1), floor_b, best, packed, cosine); bits != 0; bits &= bits - 1)
+      face_of_a(lowest_bit(bits), cosine[lowest_bit(bits)]);
+    for (std::uint32_t bits = face_mask(sb, kb, eb, Scalar(-1), floor_a, best, packed, cosine); bits != 0; bits &= bits - 1)
+      face_of_b(lowest_bit(bits), cosine[lowest_bit(bits)]);
+  } else {
+    for (std::uint32_t i = 0; i < ka; ++i)
+      face_of_a(i, Vec(Eigen::Map<const Vec>(sa.signature.contact.faces + i * fv)).dot(ea));
+    for (std::uint32_t i = 0; i < kb; ++i)
+      face_of_b(i, -Vec(Eigen::Map<const Vec>(sb.signature.contact.faces + i * fv)).dot(eb));
   }
   return dist < (packed ? best : packing * best) ? witness : no_witness;
 }

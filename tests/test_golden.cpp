@@ -8,6 +8,11 @@
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
+#include "tables/box.hpp"
+#include "tables/bunny.hpp"
+#include "tables/lshape.hpp"
+#include "tables/lshape2d.hpp"
+#include "tables/square2d.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -116,4 +121,53 @@ TEST_CASE("golden hashes of heaps of one shape on the grid (3D and 2D)")
   const std::uint64_t h2 = run_grid_heap<2>(*w2, statsim::testing::square2d_synthetic);
   std::printf("golden grid 2D: 0x%016llx\n", static_cast<unsigned long long>(h2));
   CHECK(h2 == 0x2dcb430c025696c8ull);
+}
+
+namespace {
+// A pile of two or three committed shapes meeting at their hulls (`BodyContacts::hulls`): the
+// hull candidate search, the kept face contacts and the tipping rule, which the scenes above
+// (collision spheres) never run.
+template <int D, class World, std::size_t N>
+std::uint64_t run_hull_pile(World& w, const SignatureView<D> (&shapes)[N])
+{
+  using Vec = typename Space<D>::Vec;
+  ShapeId ids[N];
+  for (std::size_t k = 0; k < N; ++k) ids[k] = w.add_shape(shapes[k]).id;
+  REQUIRE(w.add_plane(Vec::Unit(Space<D>::up_axis), 0).ok());
+  Pcg32 g(2026, 12);
+  for (std::uint32_t i = 0; i < World::max_bodies; ++i) {
+    BodyDef<D> b;
+    b.shape = ids[i % N];
+    b.mass = 1;
+    if constexpr (D == 3) {
+      b.position = Vector3(0.22f * float(i % 6), 0.22f * float((i / 6) % 6), 0.3f + 0.25f * float(i / 36));
+      b.orientation = Quaternion(g.uniform() - 0.5f, g.uniform() - 0.5f, g.uniform() - 0.5f, g.uniform() - 0.5f).normalized();
+    } else {
+      b.position = Vector2(1.6f * float(i % 8) - 6, 1 + 1.6f * float(i / 8));
+      b.orientation = Rot2::from_angle(6.283185f * g.uniform());
+    }
+    b.linear_velocity[0] = g.uniform(-0.5f, 0.5f);
+    REQUIRE(w.add_body(b).ok());
+  }
+  for (int s = 0; s < 400; ++s) REQUIRE(w.step(1.0f / 60).ok());
+  return w.state_hash();
+}
+}  // namespace
+
+TEST_CASE("golden hashes of piles of committed shapes with hull contacts (3D and 2D)")
+{
+  WorldDef3 d3;
+  d3.body_contacts = BodyContacts::hulls;
+  auto w3 = std::make_unique<World<3, 216, 8, 216 * 24>>(d3);
+  const SignatureView<3> s3[] = {tables::bunny.view(), tables::box.view(), tables::lshape.view()};
+  const std::uint64_t h3 = run_hull_pile<3>(*w3, s3);
+  std::printf("golden hulls 3D: 0x%016llx\n", static_cast<unsigned long long>(h3));
+  CHECK(h3 == 0x65db9a2d2ccba5cbull);
+  WorldDef2 d2;
+  d2.body_contacts = BodyContacts::hulls;
+  auto w2 = std::make_unique<World<2, 96, 8, 96 * 16>>(d2);
+  const SignatureView<2> s2[] = {tables::square2d.view(), tables::lshape2d.view()};
+  const std::uint64_t h2 = run_hull_pile<2>(*w2, s2);
+  std::printf("golden hulls 2D: 0x%016llx\n", static_cast<unsigned long long>(h2));
+  CHECK(h2 == 0x619bf28f03256c60ull);
 }
