@@ -185,7 +185,7 @@ Scalar largest_packing(const Shape<D>& s)
 /// far, as bits: face i with unit normal f_i (body frame) has cosine c_i = sign f_i.u > 0 with
 /// the line of centres u (body frame; sign -1 for the second body, whose faces point back
 /// along it) and p_i (o_i + floor) < best c_i, floor the least support of the other shape.
-/// Fills `cosine` for the faces set. The tests are gathered before any face is read further
+/// Fills `cosine` for every face counted. The tests are gathered before any face is read further
 /// because their outcomes follow no pattern a branch predictor could learn; `best` only falls
 /// while the faces are read, so a face not set here could not have beaten it later.
 template <int D>
