@@ -1,13 +1,16 @@
 // 2D demo: 100 unit squares and 100 L-shapes dropped onto the ground, simulated with their
 // signatures from the committed tables (tables/square2d.hpp, tables/lshape2d.hpp). Prints a
-// summary and writes a PNG of the final frame.
+// summary and writes a PNG of the final frame. Bodies touch at their hulls (the tables' body-body
+// data, `BodyContacts::hulls`), so they pile as polygons do instead of resting on one another's
+// collision spheres; --spheres gives the paper's model, the library's default.
 //
-//   drop2d [--n N] [--png FILE] [--seed S] [--frames FILE.csv] [--every K]
+//   drop2d [--n N] [--png FILE] [--seed S] [--frames FILE.csv] [--every K] [--spheres]
 //     --n       bodies of each shape (default 100, at most 500)
 //     --png     picture of the final frame (default drop2d.png; "-" for none)
 //     --seed    seed of the initial states and of the world (default 1)
 //     --frames  per-frame transforms, every K-th step (default 6), in the demos' CSV format
 //               (tools/scenes/frames.hpp): x, y with y up, z = 0, the turn as a quaternion about z
+//     --spheres body-body contacts at the collision spheres (the paper's model)
 #include "scenes/frames.hpp"
 #include "statsim/world2.hpp"
 #include "tables/lshape2d.hpp"
@@ -104,14 +107,16 @@ int main(int argc, char** argv)
   unsigned long long seed = 1;
   const char* frames = nullptr;
   int every = 6;
+  bool spheres = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--n") && i + 1 < argc) n = std::strtol(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--png") && i + 1 < argc) png = argv[++i];
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = argv[++i];
     else if (!std::strcmp(argv[i], "--every") && i + 1 < argc) every = std::max(1, int(std::strtol(argv[++i], nullptr, 10)));
+    else if (!std::strcmp(argv[i], "--spheres")) spheres = true;
     else {
-      std::fprintf(stderr, "usage: drop2d [--n N] [--png FILE|-] [--seed S] [--frames FILE.csv] [--every K]\n");
+      std::fprintf(stderr, "usage: drop2d [--n N] [--png FILE|-] [--seed S] [--frames FILE.csv] [--every K] [--spheres]\n");
       return 2;
     }
   }
@@ -122,6 +127,7 @@ int main(int argc, char** argv)
 
   WorldDef2 def;
   def.seed = seed;
+  def.body_contacts = spheres ? BodyContacts::collision_spheres : BodyContacts::hulls;
   bool set_up = world.configure(def) == Status::ok;
   const SignatureView<2> signatures[2] = {tables::square2d.view(), tables::lshape2d.view()};
   const Outline outlines[2] = {centred(square_outline, 4), centred(lshape_corners, 6)};
@@ -183,8 +189,8 @@ int main(int argc, char** argv)
   }
   if (csv) std::fclose(csv);
 
-  std::printf("drop2d: %ld squares and %ld L-shapes, %d steps of 1/60 s, %.4f ms per step\n", n, n, steps,
-              1e3 * seconds / steps);
+  std::printf("drop2d: %ld squares and %ld L-shapes, %d steps of 1/60 s, %.4f ms per step, contacts at the %s\n", n,
+              n, steps, 1e3 * seconds / steps, spheres ? "collision spheres" : "hulls");
   std::printf("  asleep %u of %u, energy guard acted %llu times\n", world.count(MotionState::asleep),
               world.body_count(), static_cast<unsigned long long>(world.energy_clamp_count()));
   for (int s = 0; s < 2; ++s) {

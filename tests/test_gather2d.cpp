@@ -420,6 +420,48 @@ TEST_CASE("compare2d: a small drop runs in both simulations and gives finite dis
   CHECK(r.box2d_b.rest_tvd <= 1.0);
 }
 
+TEST_CASE("compare2d: the frame files hold the first drop's final states of both engines")
+{
+  Compare2dOptions o = compare_options(2);
+  o.n = 6;
+  o.steps = 200;
+  const Compare2dResult r = run_compare2d(o);
+  TempDir dir("compare2d");
+  const std::string frames = dir.file("frames");
+  write_compare2d_frames(r, frames);
+  for (const MethodResult* m : {&r.box2d, &r.statsim}) {
+    CAPTURE(m->method);
+    std::ifstream in(frames + "/" + m->method + ".csv");
+    REQUIRE(in.good());
+    std::string line;
+    std::getline(in, line);
+    CHECK(line == "frame,time,body,shape,x,y,z,qw,qx,qy,qz,state,radius");
+    int rows = 0;
+    while (std::getline(in, line)) {
+      // frame,time,body,shape,x,y,0,qw,0,0,qz,state,radius: the drop's body `rows`, not the second drop's.
+      std::vector<std::string> f;
+      std::size_t from = 0;
+      for (std::size_t comma; (comma = line.find(',', from)) != std::string::npos; from = comma + 1)
+        f.push_back(line.substr(from, comma - from));
+      f.push_back(line.substr(from));
+      REQUIRE(f.size() == 13);
+      const Body2State& b = m->final[static_cast<std::size_t>(rows)];
+      CHECK(std::stoi(f[0]) == o.steps - 1);
+      CHECK(std::stoi(f[2]) == rows);
+      CHECK(f[3] == "square2d");
+      CHECK(std::stod(f[4]) == doctest::Approx(b.x).epsilon(1e-5));
+      CHECK(std::stod(f[5]) == doctest::Approx(b.y).epsilon(1e-5));
+      // The turn as a quaternion about z, (cos a/2, 0, 0, sin a/2): compare the turn it makes.
+      const double qw = std::stod(f[7]), qz = std::stod(f[10]);
+      CHECK(qw * qw - qz * qz == doctest::Approx(std::cos(b.angle)).epsilon(1e-5));
+      CHECK(2.0 * qw * qz == doctest::Approx(std::sin(b.angle)).epsilon(1e-5));
+      CHECK(std::stoi(f[11]) == (m->final_asleep[static_cast<std::size_t>(rows)] ? 2 : 0));
+      ++rows;
+    }
+    CHECK(rows == o.n);
+  }
+}
+
 TEST_CASE("compare2d: pooled drops are the drops run one by one")
 {
   Compare2dOptions o = compare_options(2);

@@ -4,6 +4,7 @@
 #include "common/atomic_file.hpp"
 #include "common/progress.hpp"
 #include "ref2d/box2d_util.hpp"
+#include "scenes/frames.hpp"
 
 #include "statsim/world2.hpp"
 
@@ -16,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -147,6 +149,7 @@ MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, cons
     const b2Vec2 v = b->GetLinearVelocity();
     m.final.push_back({p.x, p.y, b->GetAngle(), v.x, v.y, b->GetAngularVelocity()});
     m.asleep += b->IsAwake() ? 0 : 1;
+    m.final_asleep.push_back(b->IsAwake() ? 0 : 1);
   }
   return m;
 }
@@ -207,6 +210,7 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
     m.final.push_back({b.position.x(), b.position.y(), b.orientation.angle(), b.linear_velocity.x(),
                        b.linear_velocity.y(), b.angular_velocity});
     m.asleep += b.state == statsim::MotionState::asleep ? 1 : 0;
+    m.final_asleep.push_back(b.state == statsim::MotionState::asleep ? 1 : 0);
   }
   return m;
 }
@@ -316,6 +320,7 @@ MethodResult pool(const std::vector<MethodResult>& drops)
   MethodResult p = drops.front();
   const double k = static_cast<double>(drops.size());
   p.final.clear();
+  p.final_asleep.clear();
   p.asleep = 0;
   p.median_ms = p.mean_ms = p.falling_median_ms = p.active_mean_ms = 0.0;
   p.pile_height = p.mean_x = p.mad_x = p.kinetic_energy = p.max_speed = 0.0;
@@ -334,6 +339,7 @@ MethodResult pool(const std::vector<MethodResult>& drops)
     p.lowest = std::min(p.lowest, d.lowest);
     p.asleep += d.asleep;
     p.final.insert(p.final.end(), d.final.begin(), d.final.end());
+    p.final_asleep.insert(p.final_asleep.end(), d.final_asleep.begin(), d.final_asleep.end());
     for (std::size_t c = 0; c < p.histogram.size(); ++c) {
       p.histogram[c] += d.histogram[c] / k;
     }
@@ -522,11 +528,36 @@ std::string compare2d_csv(const Compare2dResult& r)
   return s;
 }
 
+void write_compare2d_frames(const Compare2dResult& r, const std::string& dir)
+{
+  std::filesystem::create_directories(dir);
+  const auto n = static_cast<std::size_t>(r.options.n);
+  const int step = r.options.steps - 1;
+  const double time = r.options.steps * r.options.dt;
+  const std::optional<statsim::SignatureView<2>> sig = signature_for(r.options.shape);
+  // The radius column is the collision sphere's, which Box2D bodies do not have: the shape's
+  // bounding radius stands in for both (`statsim render` draws spheres only when asked).
+  const double radius = sig ? static_cast<double>(sig->bounding_radius) : 0.0;
+  for (const MethodResult* m : {&r.box2d, &r.statsim}) {
+    const std::string path = (std::filesystem::path(dir) / (m->method + ".csv")).string();
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    if (f == nullptr) throw std::runtime_error("cannot write " + path);
+    scenes::write_frames_header(f);
+    for (std::size_t i = 0; i < n && i < m->final.size(); ++i) {
+      const Body2State& b = m->final[i];
+      scenes::write_frame_row(f, step, time, static_cast<std::uint32_t>(i), r.table.c_str(), Eigen::Vector2d(b.x, b.y),
+                              b.angle, m->final_asleep[i] ? 2 : 0, radius);
+    }
+    if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + path);
+  }
+}
+
 void register_compare2d_command(CLI::App& app)
 {
   struct Command {
     Compare2dOptions options;
     std::string csv;
+    std::string frames;
   };
   auto cmd = std::make_shared<Command>();
   CLI::App* c = app.add_subcommand(
@@ -552,12 +583,19 @@ void register_compare2d_command(CLI::App& app)
   c->add_flag("--pile-rest", cmd->options.pile_rest,
               "statsim: bodies settling on other bodies blend to the mean rest height (WorldDef::pile_rest)");
   c->add_option("--csv", cmd->csv, "Also write one CSV row per method to this file");
+  c->add_option("--frames", cmd->frames,
+                "Also write the first drop's final state of each engine as a frame file, DIR/box2d.csv and "
+                "DIR/statsim.csv, for `statsim render`");
   c->callback([cmd]() {
     const Compare2dResult r = run_compare2d(cmd->options);
     std::fputs(compare2d_table(r).c_str(), stdout);
     if (!cmd->csv.empty()) {
       write_file_atomic(cmd->csv, compare2d_csv(r));
       std::printf("wrote %s\n", cmd->csv.c_str());
+    }
+    if (!cmd->frames.empty()) {
+      write_compare2d_frames(r, cmd->frames);
+      std::printf("wrote %s/box2d.csv and %s/statsim.csv\n", cmd->frames.c_str(), cmd->frames.c_str());
     }
     std::fflush(stdout);
   });

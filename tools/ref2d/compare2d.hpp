@@ -49,6 +49,7 @@ struct MethodResult {
   int all_asleep_step = -1;           ///< first drop: step from which every body stayed asleep (-1: not by the end)
   int asleep = 0;                     ///< bodies asleep at the end, all drops
   std::vector<Body2State> final;      ///< final states, drop after drop
+  std::vector<std::uint8_t> final_asleep;  ///< 1 for a body asleep at the end, as `final`
   std::vector<double> histogram;      ///< fractions per rest pose of the signature, then "other"
   double pile_height = 0.0;           ///< highest point of any body (its polygon at its pose), m; mean over drops
   double mean_x = 0.0;
@@ -73,6 +74,12 @@ struct Compare2dResult {
   /// distance two samples of the reference itself show.
   MethodResult box2d_b;
 };
+
+/// Writes the final state of the first drop of Box2D and of statsim as frame files
+/// (tools/scenes/frames.hpp), `dir`/box2d.csv and `dir`/statsim.csv, one frame each (the last
+/// step), for `statsim render`; creates `dir`. Throws std::runtime_error when a file cannot be
+/// written.
+void write_compare2d_frames(const Compare2dResult& result, const std::string& dir);
 
 /// Initial states: random positions clear of each other in a region above the ground (as wide as
 /// a square grid of the bodies, twice as tall), random orientations and small random velocities;
