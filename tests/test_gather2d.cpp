@@ -418,6 +418,13 @@ TEST_CASE("compare2d: a small drop runs in both simulations and gives finite dis
   CHECK(csv.find("\nstatsim,12,150,") != std::string::npos);
   CHECK(std::isfinite(r.box2d_b.rest_tvd));
   CHECK(r.box2d_b.rest_tvd <= 1.0);
+  // Unit squares at rest cannot have centres much closer than 1 m (face to face), and in a pile
+  // of 12 each has a neighbour within a few metres.
+  for (const MethodResult* m : {&r.box2d, &r.statsim, &r.box2d_b}) {
+    CHECK(m->neighbour_median > 0.95);
+    CHECK(m->neighbour_median < 3.0);
+  }
+  CHECK(csv.find(",rest_tvd_single,neighbour_median\n") != std::string::npos);
 }
 
 TEST_CASE("compare2d: the frame files hold the first drop's final states of both engines")
@@ -478,6 +485,8 @@ TEST_CASE("compare2d: pooled drops are the drops run one by one")
     CHECK(both.statsim.histogram[k] == doctest::Approx(0.5 * (first.statsim.histogram[k] + second.statsim.histogram[k])));
     CHECK(both.box2d.histogram[k] == doctest::Approx(0.5 * (first.box2d.histogram[k] + second.box2d.histogram[k])));
   }
+  CHECK(both.statsim.neighbour_median == doctest::Approx(0.5 * (first.statsim.neighbour_median + second.statsim.neighbour_median)));
+  CHECK(both.box2d.neighbour_median == doctest::Approx(0.5 * (first.box2d.neighbour_median + second.box2d.neighbour_median)));
   REQUIRE(both.statsim.final.size() == 16);
   CHECK(both.statsim.final[0].x == first.statsim.final[0].x);
   CHECK(both.statsim.final[8].x == second.statsim.final[0].x);

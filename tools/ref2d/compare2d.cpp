@@ -115,6 +115,20 @@ void analyse(MethodResult& m, const Shape2& shape, const statsim::SignatureView<
   for (const Body2State& b : m.final) {
     m.mad_x += std::fabs(b.x - m.mean_x) / static_cast<double>(n);
   }
+  std::vector<double> nearest;
+  for (std::size_t i = 0; i < n; ++i) {
+    double d2 = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j != i) {
+        d2 = std::min(d2, (m.final[i].x - m.final[j].x) * (m.final[i].x - m.final[j].x) +
+                              (m.final[i].y - m.final[j].y) * (m.final[i].y - m.final[j].y));
+      }
+    }
+    if (n > 1) {
+      nearest.push_back(std::sqrt(d2));
+    }
+  }
+  m.neighbour_median = nearest.empty() ? 0.0 : median(nearest);
 }
 
 MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, const statsim::SignatureView<2>& sig,
@@ -323,7 +337,7 @@ MethodResult pool(const std::vector<MethodResult>& drops)
   p.final_asleep.clear();
   p.asleep = 0;
   p.median_ms = p.mean_ms = p.falling_median_ms = p.active_mean_ms = 0.0;
-  p.pile_height = p.mean_x = p.mad_x = p.kinetic_energy = p.max_speed = 0.0;
+  p.pile_height = p.mean_x = p.mad_x = p.kinetic_energy = p.max_speed = p.neighbour_median = 0.0;
   p.lowest = std::numeric_limits<double>::infinity();
   std::fill(p.histogram.begin(), p.histogram.end(), 0.0);
   for (const MethodResult& d : drops) {
@@ -332,6 +346,7 @@ MethodResult pool(const std::vector<MethodResult>& drops)
     p.falling_median_ms += d.falling_median_ms / k;
     p.active_mean_ms += d.active_mean_ms / k;
     p.pile_height += d.pile_height / k;
+    p.neighbour_median += d.neighbour_median / k;
     p.mean_x += d.mean_x / k;
     p.mad_x += d.mad_x / k;
     p.kinetic_energy += d.kinetic_energy / k;
@@ -504,6 +519,8 @@ std::string compare2d_table(const Compare2dResult& r)
   row("spread W1 / box2d spread", "0", fmt("%.3f", s.spread_w1), fmt("%.3f", bb.spread_w1));
   row("pile height (m)", fmt("%.3f", b.pile_height), fmt("%.3f", s.pile_height), fmt("%.3f", bb.pile_height));
   row("lowest point (m)", fmt("%.4f", b.lowest), fmt("%.4f", s.lowest), fmt("%.4f", bb.lowest));
+  row("nearest neighbour, median (m)", fmt("%.3f", b.neighbour_median), fmt("%.3f", s.neighbour_median),
+      fmt("%.3f", bb.neighbour_median));
   row("largest final speed (m/s)", fmt("%.4f", b.max_speed), fmt("%.4f", s.max_speed), fmt("%.4f", bb.max_speed));
   row("final kinetic energy (J)", fmt("%.4g", b.kinetic_energy), fmt("%.4g", s.kinetic_energy), fmt("%.4g", bb.kinetic_energy));
   t += "  speed-up per step: " + fmt("%.1f", b.median_ms / std::max(s.median_ms, 1e-12)) + "x (median), " +
@@ -517,13 +534,13 @@ std::string compare2d_csv(const Compare2dResult& r)
 {
   std::string s =
       "method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep,drops,"
-      "rest_tvd_single\n";
+      "rest_tvd_single,neighbour_median\n";
   for (const MethodResult* m : {&r.box2d, &r.box2d_b, &r.statsim}) {
     s += m->method + "," + std::to_string(r.options.n) + "," + std::to_string(r.options.steps) + "," +
          fmt("%.6f", m->median_ms) + "," + fmt("%.6f", m->mean_ms) + "," + fmt("%.6f", m->falling_median_ms) + "," +
          fmt("%.6f", m->active_mean_ms) + "," + fmt("%.6f", m->rest_tvd) + "," + fmt("%.6f", m->spread_w1) + "," +
          fmt("%.6f", m->pile_height) + "," + std::to_string(m->asleep) + "," + std::to_string(r.options.drops) + "," +
-         fmt("%.6f", m->rest_tvd_single) + "\n";
+         fmt("%.6f", m->rest_tvd_single) + "," + fmt("%.6f", m->neighbour_median) + "\n";
   }
   return s;
 }

@@ -58,6 +58,9 @@ struct MethodResult {
   double rest_tvd_single = 0.0;       ///< the same per drop, mean over drops (one drop alone is noisy)
   double spread_w1 = 0.0;             ///< W1 of the pooled x distributions / Box2D's mad_x
   double lowest = 0.0;                ///< lowest point of any body, m (< 0: sunk into the ground)
+  /// Median over the bodies of the distance from each centre to the nearest other centre, m;
+  /// mean over drops. How closely the bodies pack: unit squares lying face to face are 1 m apart.
+  double neighbour_median = 0.0;
   double max_speed = 0.0;             ///< largest final |v|, m/s
   double kinetic_energy = 0.0;        ///< final total kinetic energy, J; mean over drops
 };
