@@ -1,16 +1,20 @@
-// statsim render / export: frame files, the rasterizer, the GIF writer and the glTF export.
+// statsim render / export: frame files, the rasterizer, the GIF writer and the glTF export; the
+// frame files of `statsim reference-run`.
 #include <doctest/doctest.h>
 
 #include "export/gltf_export.hpp"
 #include "export/tinygltf.hpp"
 #include "render/frames.hpp"
+#include "render/reference_run.hpp"
 #include "render/render.hpp"
+#include "support/temp_dir.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 using namespace statsim::tools;
@@ -295,4 +299,56 @@ TEST_CASE("export writes binary glTF that loads back with its nodes and keyframe
   const tinygltf::Mesh& mesh = m.meshes[std::size_t(m.nodes[0].mesh)];
   CHECK(m.accessors[std::size_t(mesh.primitives[0].attributes.at("POSITION"))].count == 8);
   CHECK(m.accessors[std::size_t(mesh.primitives[0].indices)].count == 36);
+}
+
+namespace {
+std::string read_all(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+TEST_CASE("reference-run: statsim with hull contacts runs the same scene, touching at the hulls")
+{
+  statsim::testing::TempDir dir("reference-run");
+  render::ReferenceRunOptions o;
+  o.scene = "bunnies12";
+  o.meshes_dir = render::default_meshes_dir();
+  o.engine = "statsim";
+  o.seconds = 3.0;
+  o.every = 120;
+  std::string error;
+  CAPTURE(error);
+  o.frames = dir.file("spheres.csv");
+  REQUIRE(render::reference_run(o, error));
+  // Again: the runner's world is set up afresh, so a second run gives the same bytes.
+  o.frames = dir.file("again.csv");
+  REQUIRE(render::reference_run(o, error));
+  CHECK(read_all(dir.file("again.csv")) == read_all(dir.file("spheres.csv")));
+  o.hull_contacts = true;
+  o.frames = dir.file("hulls.csv");
+  REQUIRE(render::reference_run(o, error));
+  const std::string spheres = read_all(dir.file("spheres.csv")), hulls = read_all(dir.file("hulls.csv"));
+  // The first frame is the same dropped scene; by the last the bodies have met at their hulls.
+  const std::string first = spheres.substr(0, spheres.find("\n120,"));
+  REQUIRE(first.size() < spheres.size());
+  CHECK(first.size() > 100);
+  CHECK(hulls.compare(0, first.size(), first) == 0);
+  CHECK(spheres != hulls);
+}
+
+TEST_CASE("reference-run: hull contacts are refused for Bullet, and nothing is written")
+{
+  statsim::testing::TempDir dir("reference-run");
+  render::ReferenceRunOptions o;
+  o.scene = "bunnies3";
+  o.meshes_dir = render::default_meshes_dir();
+  o.engine = "bullet";
+  o.hull_contacts = true;
+  o.frames = dir.file("bullet.csv");
+  std::string error;
+  CHECK_FALSE(render::reference_run(o, error));
+  CHECK(error.find("--hull-contacts") != std::string::npos);
+  CHECK_FALSE(std::ifstream(o.frames).good());
 }

@@ -25,7 +25,7 @@ namespace {
 constexpr std::uint32_t kCapacity = 4096;
 // Bullet steps a frame in this many internal steps: GImpact at 1/60 s lets fast bunnies sink.
 constexpr int kSubsteps = 4;
-World3<kCapacity> g_world;  // large: kept out of the stack
+using RunWorld = World3<kCapacity>;
 
 struct Written {
   std::FILE* f = nullptr;
@@ -51,6 +51,10 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
   }
   if (o.engine != "bullet" && o.engine != "statsim") {
     error = "unknown engine '" + o.engine + "' (bullet, statsim)";
+    return false;
+  }
+  if (o.hull_contacts && o.engine != "statsim") {
+    error = "--hull-contacts is statsim's (Bullet touches at its meshes)";
     return false;
   }
   if (o.every < 1 || !(o.seconds > 0)) {
@@ -87,9 +91,14 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
   if (o.engine == "statsim") {
     WorldDef3 def;
     def.seed = o.seed;
-    const Status configured = g_world.configure(def);
-    const Added<ShapeId> added = g_world.add_shape(sig);
-    if (configured != Status::ok || !added.ok() || !g_world.add_plane(Vector3(0, 0, 1), 0).ok()) {
+    if (o.hull_contacts) def.body_contacts = BodyContacts::hulls;
+    // A world of its own for every run (large: on the heap, not the stack), so that a run never
+    // sees the bodies of the one before.
+    const auto world = std::make_unique<RunWorld>(def);
+    RunWorld& w = *world;
+    const Status configured = w.construction_status();
+    const Added<ShapeId> added = w.add_shape(sig);
+    if (configured != Status::ok || !added.ok() || !w.add_plane(Vector3(0, 0, 1), 0).ok()) {
       error = "statsim world set-up failed";
       return false;
     }
@@ -102,25 +111,25 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
       b.angular_velocity = s.angular_velocity.cast<Scalar>();
       b.shape = shape;
       b.mass = sig.mass;
-      if (!g_world.add_body(b).ok()) {
+      if (!w.add_body(b).ok()) {
         error = "statsim add_body failed";
         return false;
       }
     }
     for (int s = 0; s < steps; ++s) {
-      if (g_world.step(Scalar(dt)).status != Status::ok) {
+      if (w.step(Scalar(dt)).status != Status::ok) {
         error = "statsim step failed";
         return false;
       }
       if (s % o.every != 0) continue;
-      for (std::uint32_t i = 0; i < g_world.body_count(); ++i) {
-        const Body3& b = g_world.body(i);
+      for (std::uint32_t i = 0; i < w.body_count(); ++i) {
+        const Body3& b = w.body(i);
         write_frame_row(out.f, s, double(s + 1) * dt, int(i), "bunny", b.position.cast<double>(),
                         b.orientation.cast<double>(), int(b.state), double(b.radius));
       }
     }
     std::printf("reference-run: %s, statsim (tables/bunny.hpp), %d steps of 1/60 s, %u of %u asleep -> %s\n",
-                o.scene.c_str(), steps, g_world.count(MotionState::asleep), g_world.body_count(), o.frames.c_str());
+                o.scene.c_str(), steps, w.count(MotionState::asleep), w.body_count(), o.frames.c_str());
     return true;
   }
 

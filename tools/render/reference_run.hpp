@@ -15,6 +15,9 @@ struct ReferenceRunOptions {
   double seconds = 6.0;             ///< simulated time
   int every = 6;                    ///< write every k-th step of 1/60 s
   std::uint64_t seed = 1;           ///< scene layout (and statsim's world seed)
+  /// statsim: bodies touch at their hulls (`BodyContacts::hulls`, as `statsim bench` and
+  /// `statsim fidelity` run them) instead of the paper's collision spheres, the library's default
+  bool hull_contacts = false;
   std::string meshes_dir;
 };
 

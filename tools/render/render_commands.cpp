@@ -279,6 +279,9 @@ void register_render_commands(CLI::App& app)
   rr->add_option("--every", o->every, "write every k-th step of 1/60 s")->check(CLI::Range(1, 100000))->capture_default_str();
   rr->add_option("--seed", o->seed, "scene seed")->capture_default_str();
   rr->add_option("--meshes", o->meshes_dir, "directory of the meshes")->capture_default_str();
+  rr->add_flag("--hull-contacts", o->hull_contacts,
+               "statsim: bodies touch at their hulls (BodyContacts::hulls, as statsim bench and fidelity run them), "
+               "not at the paper's collision spheres");
   rr->callback([o]() {
     std::string error;
     if (!render::reference_run(*o, error)) {
