@@ -307,20 +307,27 @@ std::string read_all(const std::string& path)
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
+
+// The shared bunny drop of `scene` with `engine`, written to `frames`.
+render::ReferenceRunOptions run_options(const std::string& scene, const std::string& engine, const std::string& frames)
+{
+  render::ReferenceRunOptions o;
+  o.scene = scene;
+  o.meshes_dir = render::default_meshes_dir();
+  o.engine = engine;
+  o.frames = frames;
+  return o;
+}
 }  // namespace
 
 TEST_CASE("reference-run: statsim with hull contacts runs the same scene, touching at the hulls")
 {
   statsim::testing::TempDir dir("reference-run");
-  render::ReferenceRunOptions o;
-  o.scene = "bunnies12";
-  o.meshes_dir = render::default_meshes_dir();
-  o.engine = "statsim";
+  render::ReferenceRunOptions o = run_options("bunnies12", "statsim", dir.file("spheres.csv"));
   o.seconds = 3.0;
   o.every = 120;
   std::string error;
   CAPTURE(error);
-  o.frames = dir.file("spheres.csv");
   REQUIRE(render::reference_run(o, error));
   // Again: the runner's world is set up afresh, so a second run gives the same bytes.
   o.frames = dir.file("again.csv");
@@ -341,12 +348,8 @@ TEST_CASE("reference-run: statsim with hull contacts runs the same scene, touchi
 TEST_CASE("reference-run: hull contacts are refused for Bullet, and nothing is written")
 {
   statsim::testing::TempDir dir("reference-run");
-  render::ReferenceRunOptions o;
-  o.scene = "bunnies3";
-  o.meshes_dir = render::default_meshes_dir();
-  o.engine = "bullet";
+  render::ReferenceRunOptions o = run_options("bunnies3", "bullet", dir.file("bullet.csv"));
   o.hull_contacts = true;
-  o.frames = dir.file("bullet.csv");
   std::string error;
   CHECK_FALSE(render::reference_run(o, error));
   CHECK(error.find("--hull-contacts") != std::string::npos);
