@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -467,6 +468,41 @@ TEST_CASE("compare2d: the frame files hold the first drop's final states of both
     }
     CHECK(rows == o.n);
   }
+}
+
+TEST_CASE("compare2d: the history samples the highest centre and the bodies awake, pooled over the drops")
+{
+  Compare2dOptions o = compare_options(2);
+  o.n = 8;
+  o.steps = 120;
+  o.history_every = 0.5;  // 30 steps of 1/60 s
+  const Compare2dResult both = run_compare2d(o);
+  o.drops = 1;
+  const Compare2dResult first = run_compare2d(o);
+  o.seed += 1;
+  const Compare2dResult second = run_compare2d(o);
+  for (const MethodResult* m : {&both.box2d, &both.statsim, &first.box2d, &first.statsim}) {
+    REQUIRE(m->history.size() == 4);
+    CHECK(m->history[0].time == doctest::Approx(0.5));
+    CHECK(m->history[3].time == doctest::Approx(2.0));
+  }
+  // The last sample is taken after the last step: its highest centre is that of the final states.
+  for (const MethodResult* m : {&first.box2d, &first.statsim}) {
+    double highest = -1e9;
+    int awake = 0;
+    for (std::size_t i = 0; i < m->final.size(); ++i) {
+      highest = std::max(highest, m->final[i].y);
+      awake += m->final_asleep[i] ? 0 : 1;
+    }
+    CHECK(m->history[3].highest == doctest::Approx(highest));
+    CHECK(m->history[3].awake == awake);
+  }
+  for (std::size_t t = 0; t < 4; ++t) {
+    CHECK(both.statsim.history[t].highest == doctest::Approx(0.5 * (first.statsim.history[t].highest + second.statsim.history[t].highest)));
+    CHECK(both.box2d.history[t].awake == doctest::Approx(0.5 * (first.box2d.history[t].awake + second.box2d.history[t].awake)));
+  }
+  o.history_every = 0.0;
+  CHECK(run_compare2d(o).statsim.history.empty());
 }
 
 TEST_CASE("compare2d: pooled drops are the drops run one by one")

@@ -131,6 +131,12 @@ void analyse(MethodResult& m, const Shape2& shape, const statsim::SignatureView<
   m.neighbour_median = nearest.empty() ? 0.0 : median(nearest);
 }
 
+// Whole steps between two history samples (0: no history).
+int history_steps(const Compare2dOptions& o)
+{
+  return o.history_every > 0.0 ? std::max(1, static_cast<int>(std::lround(o.history_every / o.dt))) : 0;
+}
+
 MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, const statsim::SignatureView<2>& sig,
                             const std::vector<Body2State>& init)
 {
@@ -156,6 +162,14 @@ MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, cons
       m.all_asleep_step = step;
     } else if (awake > 0) {
       m.all_asleep_step = -1;
+    }
+    const int every = history_steps(o);
+    if (every > 0 && (step + 1) % every == 0) {
+      double highest = -std::numeric_limits<double>::infinity();
+      for (b2Body* b : bodies) {
+        highest = std::max(highest, static_cast<double>(b->GetPosition().y));
+      }
+      m.history.push_back({(step + 1) * o.dt, highest, static_cast<double>(awake)});
     }
   }
   for (b2Body* b : bodies) {
@@ -217,6 +231,14 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
       m.all_asleep_step = step;
     } else if (asleep < world->body_count()) {
       m.all_asleep_step = -1;
+    }
+    const int every = history_steps(o);
+    if (every > 0 && (step + 1) % every == 0) {
+      double highest = -std::numeric_limits<double>::infinity();
+      for (std::uint32_t i = 0; i < world->body_count(); ++i) {
+        highest = std::max(highest, static_cast<double>(world->body(i).position.y()));
+      }
+      m.history.push_back({(step + 1) * o.dt, highest, static_cast<double>(world->body_count() - asleep)});
     }
   }
   for (std::uint32_t i = 0; i < world->body_count(); ++i) {
@@ -335,6 +357,9 @@ MethodResult pool(const std::vector<MethodResult>& drops)
   const double k = static_cast<double>(drops.size());
   p.final.clear();
   p.final_asleep.clear();
+  for (HistorySample& h : p.history) {
+    h.highest = h.awake = 0.0;  // the times stay; every drop samples the same steps
+  }
   p.asleep = 0;
   p.median_ms = p.mean_ms = p.falling_median_ms = p.active_mean_ms = 0.0;
   p.pile_height = p.mean_x = p.mad_x = p.kinetic_energy = p.max_speed = p.neighbour_median = 0.0;
@@ -355,6 +380,10 @@ MethodResult pool(const std::vector<MethodResult>& drops)
     p.asleep += d.asleep;
     p.final.insert(p.final.end(), d.final.begin(), d.final.end());
     p.final_asleep.insert(p.final_asleep.end(), d.final_asleep.begin(), d.final_asleep.end());
+    for (std::size_t t = 0; t < p.history.size(); ++t) {
+      p.history[t].highest += d.history[t].highest / k;
+      p.history[t].awake += d.history[t].awake / k;
+    }
     for (std::size_t c = 0; c < p.histogram.size(); ++c) {
       p.histogram[c] += d.histogram[c] / k;
     }
@@ -523,6 +552,12 @@ std::string compare2d_table(const Compare2dResult& r)
       fmt("%.3f", bb.neighbour_median));
   row("largest final speed (m/s)", fmt("%.4f", b.max_speed), fmt("%.4f", s.max_speed), fmt("%.4f", bb.max_speed));
   row("final kinetic energy (J)", fmt("%.4g", b.kinetic_energy), fmt("%.4g", s.kinetic_energy), fmt("%.4g", bb.kinetic_energy));
+  const auto sample = [](const MethodResult& m, std::size_t k) {
+    return k < m.history.size() ? fmt("%.2f", m.history[k].highest) + " (" + fmt("%.0f", m.history[k].awake) + ")" : "-";
+  };
+  for (std::size_t k = 0; k < b.history.size(); ++k) {
+    row("highest centre at " + fmt("%g", b.history[k].time) + " s (m; awake)", sample(b, k), sample(s, k), sample(bb, k));
+  }
   t += "  speed-up per step: " + fmt("%.1f", b.median_ms / std::max(s.median_ms, 1e-12)) + "x (median), " +
        fmt("%.1f", b.mean_ms / std::max(s.mean_ms, 1e-12)) + "x (mean), " +
        fmt("%.1f", b.falling_median_ms / std::max(s.falling_median_ms, 1e-12)) + "x while falling, " +
@@ -599,6 +634,10 @@ void register_compare2d_command(CLI::App& app)
       ->capture_default_str();
   c->add_flag("--pile-rest", cmd->options.pile_rest,
               "statsim: bodies settling on other bodies blend to the mean rest height (WorldDef::pile_rest)");
+  c->add_option("--history-every", cmd->options.history_every,
+                "Also show the highest centre and the bodies awake every this many seconds (mean over the drops)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   c->add_option("--csv", cmd->csv, "Also write one CSV row per method to this file");
   c->add_option("--frames", cmd->frames,
                 "Also write the first drop's final state of each engine as a frame file, DIR/box2d.csv and "

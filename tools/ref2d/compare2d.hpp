@@ -29,6 +29,16 @@ struct Compare2dOptions {
   /// own share of tilted bodies varies widely between seeds (tools/ref2d/README.md).
   int drops = 10;
   bool pile_rest = false;        ///< statsim's WorldDef::pile_rest
+  /// When above 0: every this many seconds of simulated time (rounded to whole steps), record the
+  /// highest centre and the bodies awake (`MethodResult::history`).
+  double history_every = 0.0;
+};
+
+/// One sample of a run's history (`Compare2dOptions::history_every`).
+struct HistorySample {
+  double time = 0.0;     ///< s after the start
+  double highest = 0.0;  ///< highest centre of any body, m; mean over drops
+  double awake = 0.0;    ///< bodies awake; mean over drops
 };
 
 /// Initial state of one body (both simulations start from these).
@@ -50,6 +60,7 @@ struct MethodResult {
   int asleep = 0;                     ///< bodies asleep at the end, all drops
   std::vector<Body2State> final;      ///< final states, drop after drop
   std::vector<std::uint8_t> final_asleep;  ///< 1 for a body asleep at the end, as `final`
+  std::vector<HistorySample> history;  ///< when Compare2dOptions::history_every > 0
   std::vector<double> histogram;      ///< fractions per rest pose of the signature, then "other"
   double pile_height = 0.0;           ///< highest point of any body (its polygon at its pose), m; mean over drops
   double mean_x = 0.0;
