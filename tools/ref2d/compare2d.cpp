@@ -146,6 +146,7 @@ MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, cons
   world.SetAllowSleeping(true);
   const std::vector<b2Body*> bodies = add_box2d_pile(world, shape, sig, init);
   const float h = static_cast<float>(o.dt);
+  const int every = history_steps(o);
   for (int step = 0; step < o.steps; ++step) {
     const auto t0 = std::chrono::steady_clock::now();
     world.Step(h, 8, 3);
@@ -163,7 +164,6 @@ MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, cons
     } else if (awake > 0) {
       m.all_asleep_step = -1;
     }
-    const int every = history_steps(o);
     if (every > 0 && (step + 1) % every == 0) {
       double highest = -std::numeric_limits<double>::infinity();
       for (b2Body* b : bodies) {
@@ -215,6 +215,7 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
     }
   }
   const float h = static_cast<float>(o.dt);
+  const int every = history_steps(o);
   for (int step = 0; step < o.steps; ++step) {
     const auto t0 = std::chrono::steady_clock::now();
     const statsim::StepResult r = world->step(h);
@@ -232,7 +233,6 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
     } else if (asleep < world->body_count()) {
       m.all_asleep_step = -1;
     }
-    const int every = history_steps(o);
     if (every > 0 && (step + 1) % every == 0) {
       double highest = -std::numeric_limits<double>::infinity();
       for (std::uint32_t i = 0; i < world->body_count(); ++i) {
