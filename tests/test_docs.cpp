@@ -431,6 +431,40 @@ TEST_CASE("docs: README.md's headline numbers are those of the committed measure
                           {grouped(std::llround(number(i16, "bodies")))}});
 }
 
+TEST_CASE("docs: tools/bench/README.md's table of thread CPU time is examples/images/bench.csv")
+{
+  const auto chapter = lines_of(read_text("tools/bench/README.md"));
+  const std::string file = "examples/images/bench.csv";
+  const auto bench = read_csv(file);
+  const auto title = std::find(chapter.begin(), chapter.end(), "Thread CPU ms per step; Bullet with btAxisSweep3 (the paper's broad phase):");
+  REQUIRE(title != chapter.end());
+  int rows = 0;
+  for (auto it = title + 4; it != chapter.end() && it->rfind("| ", 0) == 0; ++it, ++rows) {
+    const auto cells = table_cells(*it);
+    REQUIRE(cells.size() == 7);
+    std::string n;
+    for (const char c : cells[0])
+      if (std::isdigit(static_cast<unsigned char>(c)))
+        n += c;
+    // Columns: N, full, low, spheres7, sphere, statistical, statistical (sap); each cell starts with
+    // the figure, three significant digits.
+    const std::vector<std::pair<std::string, std::string>> columns{
+        {"full", "sap"}, {"low", "sap"}, {"sphere", "sap"}, {"statistical", "auto"}, {"statistical-sap", "sap"}};
+    const std::vector<std::size_t> index{1, 2, 4, 5, 6};
+    for (std::size_t k = 0; k < columns.size(); ++k) {
+      const std::string cell = cells[index[k]].substr(1);
+      if (cell.empty() || cell.rfind(" ", 0) == 0 || cell.rfind("skipped", 0) == 0)
+        continue;
+      const Row r = find_row(bench, {{"method", columns[k].first}, {"n", n}, {"broadphase", columns[k].second}}, file);
+      const std::string want = sig(number(r, "cpu_ms"), 3);
+      CHECK_MESSAGE(cell.rfind(want + " ", 0) == 0, "tools/bench/README.md, N = " << n << ", " << columns[k].first
+                                                                                << ": should start with " << want
+                                                                                << ": " << *it);
+    }
+  }
+  CHECK(rows == 5);
+}
+
 TEST_CASE("docs: the firmware's footprint table is examples/images/footprint.csv")
 {
   const auto chapter = lines_of(read_text("examples/firmware/README.md"));
