@@ -501,3 +501,26 @@ TEST_CASE("docs: the web page's size is examples/web/size.csv")
   const std::string page_kb = "a " + std::to_string((page + 500) / 1000) + " KB page";
   CHECK_MESSAGE(readme.find(page_kb) != std::string::npos, "README.md should say " << page_kb);
 }
+
+TEST_CASE("docs: tests/README.md names every file of tests/")
+{
+  const std::string list = read_text("tests/README.md");
+  int files = 0;
+  for (auto it = fs::recursive_directory_iterator("tests"); it != fs::recursive_directory_iterator(); ++it) {
+    const std::string name = it->path().filename().string();
+    if (it->is_directory() && (name == "meshes" || name == "corpus")) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (!it->is_regular_file() || name == "README.md")
+      continue;
+    ++files;
+    const std::string path = it->path().lexically_relative("tests").generic_string();
+    const bool named = list.find("\n- `" + path + "` ") != std::string::npos ||
+                       list.find("\n- `" + path + "`:") != std::string::npos;
+    CHECK_MESSAGE(named,
+                  "tests/README.md has no line \"- `" << path << "` ...\" for tests/" << path);
+  }
+  CHECK(files > 50);
+}
+
