@@ -5,7 +5,7 @@
 /// step), not its shape's hull; sleeping bodies count, removed ones do not. Queries read the
 /// world and change nothing; they allocate nothing and call back into the caller for each hit.
 ///
-/// They search the records of the broad phase in use (statsim/query_search.hpp), so their cost
+/// They search the records of the broad phase in use (statsim/detail/query_search.hpp), so their cost
 /// grows with the bodies near the ray or sphere, not with the world's bodies. The records hold
 /// where bodies were when the last step's broad phase ran; the step measures how far any body has
 /// moved from its record since (`detail::measure_drift`), and a query widens its search by that
@@ -21,7 +21,7 @@
 /// radius and drift) of the ray or centre; with sweep-and-prune, the entries whose interval on
 /// the sweep axis meets the query's, a slab across the world.
 
-#include "statsim/query_search.hpp"
+#include "statsim/detail/query_search.hpp"
 #include "statsim/world.hpp"
 
 #include <cmath>

@@ -26,7 +26,8 @@
 /// and the contact flags' bookkeeping (a body whose flags are set and that is not awake is
 /// marked for the next step to clear, as the last step's touching pairs would have).
 
-#include "statsim/snapshot_format.hpp"
+#include "statsim/detail/slope.hpp"
+#include "statsim/detail/snapshot_format.hpp"
 #include "statsim/world.hpp"
 
 #include <cmath>

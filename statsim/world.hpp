@@ -6,36 +6,40 @@
 /// capacity-erased `WorldCore<D>`, so helpers can take a `WorldCore<3>&` whatever the capacity and
 /// the code is compiled once per dimension, not once per capacity.
 ///
-/// A step, in order (each phase is a function of `detail`, in the file named):
+/// A step, in order (each phase is a function of `detail`, in the file of statsim/detail/ named):
 ///  1. integrate awake bodies (semi-implicit Euler; orientation without trigonometry;
-///     world_data.hpp; a body rolling on a slope in substeps with its slope contacts,
-///     slope_contact.hpp) and set the statistical bodies' collision radii (rest_and_sleep.hpp);
+///     integrate.hpp; a body rolling on a slope in substeps with its slope contacts,
+///     slope_contact.hpp) and set the statistical bodies' collision radii (sleep.hpp);
 ///  2. broad phase: pairs within `detail::pair_radius` of each other, from a hashed grid or from
-///     sweep-and-prune (intervals on the bounding radius; find_pairs.hpp);
+///     sweep-and-prune (intervals on the bounding radius; broad_phase.hpp); then the
+///     impacts of the step are recorded (events.hpp);
 ///  3. impact pass: body-plane then body-body contacts get the bodies' response (the statistical
 ///     response for statistical bodies, the particle response for plain spheres); planes push
-///     bodies out of them (contact_solver.hpp, as are 4 and 5);
+///     bodies out of them (contact_passes.hpp, as are 4 and 5);
 ///  4. support passes (`WorldDef::support_iterations`): inelastic, removing approach velocity
 ///     left at resting contacts, planes last;
 ///  5. shock pass: contacts from the bottom up, the lower body immovable; overlaps between bodies
 ///     are corrected here, softly (`allowed_overlap`, `overlap_correction`), then again in
 ///     `position_iterations` passes that only move bodies;
-///  6. motion state (rest_and_sleep.hpp): moving, settling (slow and touching), asleep (slow for
+///  6. motion state (sleep.hpp): moving, settling (slow and touching), asleep (slow for
 ///     `sleep_time`).
 /// Sleeping bodies are not integrated and act as static supports until hit harder than
 /// `wake_speed` (or, with hull contacts, pressed deep: `detail::hull_wake_overlap`).
 
-#include "statsim/body_ops.hpp"
-#include "statsim/contact_solver.hpp"
-#include "statsim/events.hpp"
-#include "statsim/find_pairs.hpp"
-#include "statsim/rest_and_sleep.hpp"
-#include "statsim/shape_setup.hpp"
+#include "statsim/detail/body_ops.hpp"
+#include "statsim/detail/broad_phase.hpp"
+#include "statsim/detail/checks.hpp"
+#include "statsim/detail/contact_passes.hpp"
+#include "statsim/detail/events.hpp"
+#include "statsim/detail/integrate.hpp"
+#include "statsim/detail/shape_setup.hpp"
+#include "statsim/detail/sleep.hpp"
+#include "statsim/detail/slope.hpp"
+#include "statsim/detail/state_hash.hpp"
+#include "statsim/detail/world_data.hpp"
+#include "statsim/detail/world_storage.hpp"
 #include "statsim/signature_scale.hpp"
-#include "statsim/world_checks.hpp"
-#include "statsim/world_data.hpp"
 #include "statsim/world_def.hpp"
-#include "statsim/world_storage.hpp"
 
 #include <array>
 #include <cstddef>

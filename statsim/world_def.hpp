@@ -3,8 +3,7 @@
 /// What a world is made of: the limits on inputs, the ids, the definitions users fill in
 /// (`ShapeDef`, `BodyDef`, `WorldDef`) and the state the world keeps (`Body`, `Shape`).
 
-#include "statsim/broadphase.hpp"
-#include "statsim/contact.hpp"
+#include "statsim/detail/narrow_phase.hpp"
 #include "statsim/statistical.hpp"
 #include "statsim/status.hpp"
 
@@ -147,7 +146,32 @@ struct Workers {
   void* context = nullptr;                 ///< passed to both callbacks as `user_context`
 };
 
-/// Where two bodies touch (see statsim/hull_contact.hpp).
+/// Which broad phase a world uses.
+enum class BroadPhase : std::uint8_t {
+  /// Uniform grid of cells as wide as the widest reach of two bodies (`detail::pair_radius`: the
+  /// bounding radius with hull contacts, else about the collision sphere), hashed into a fixed
+  /// table: each awake body looks at the 3^D cells around it. Cost grows with awake bodies times
+  /// their neighbours.
+  grid,
+  /// Sweep-and-prune along one axis (paper 4.1). Cost grows with the bodies whose intervals
+  /// overlap on that axis, which in a wide pile is many more than the true neighbours.
+  sweep_and_prune,
+  /// Sweep-and-prune up to `WorldDef::grid_above_bodies` bodies, the grid above: sweep-and-prune
+  /// is the faster in small worlds, the grid in large ones (`statsim bench`, tools/bench/README.md).
+  automatic,
+};
+
+/// A candidate pair of bodies, by index, a < b: 8 bytes, as a pair buffer holds several per body.
+/// (`b` and `witness` are bit-fields: copy them into an integer before binding a reference.)
+struct Pair {
+  std::uint32_t a;
+  std::uint32_t b : 24;  ///< body indices have `body_index_bits` (20) bits
+  /// With hull contacts, the candidate normal the impact pass found for a touching pair
+  /// (`detail::find_hull_witness`), which the later passes of the step reuse; 0 in a new pair.
+  std::uint32_t witness : 8;
+};
+
+/// Where two bodies touch (see statsim/detail/hull.hpp).
 enum class BodyContacts : std::uint8_t {
   /// Paper 3.3.1: at the sum of their collision radii, whatever their orientations.
   collision_spheres,

@@ -185,7 +185,7 @@ TEST_CASE("the impact threshold is a world parameter")
 TEST_CASE("a box tumbling down a slope records the strikes of its faces")
 {
   // A body rolling on a slope moves through the step in substeps with its slope contacts
-  // (statsim/slope_contact.hpp), and the step's own recording leaves those contacts to them: the
+  // (statsim/detail/slope_contact.hpp), and the step's own recording leaves those contacts to them: the
   // strikes come from the substeps. A box resting on a face of 20 degrees, rolled about its
   // downhill edge fast enough to tumble over the next faces, strikes the plane with them.
   WorldDef3 def;

@@ -9,7 +9,7 @@
 #include "ref3d/signature_json.hpp"
 
 #include "statsim/signature.hpp"
-#include "statsim/world_checks.hpp"
+#include "statsim/detail/checks.hpp"
 
 #include "support/table_header.hpp"
 #include "support/temp_dir.hpp"

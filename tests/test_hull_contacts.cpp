@@ -1,4 +1,4 @@
-// Body-body contacts at the shapes' hulls (statsim/hull_contact.hpp, BodyContacts::hulls) with the
+// Body-body contacts at the shapes' hulls (statsim/detail/hull.hpp, BodyContacts::hulls) with the
 // committed tables' body-body data: the support map against the closed form, stacks that hold
 // their true height, and piles that end asleep, above the ground and without overlaps.
 #include "statsim/snapshot.hpp"

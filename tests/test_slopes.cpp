@@ -1,4 +1,4 @@
-// Statistical bodies on tilted planes meet them with their hulls (statsim/slope_contact.hpp): with
+// Statistical bodies on tilted planes meet them with their hulls (statsim/detail/slope_contact.hpp): with
 // friction above the slope's tangent they come to rest and fall asleep in a rest pose against the
 // plane; below it they keep going; a body rolled over an edge tumbles onto the next face as a
 // rigid one does.

@@ -4,8 +4,8 @@
 /// an impulse, wake it or put it to sleep. Each checks everything first and returns a `Status`,
 /// so that a rejected call changes nothing; `WorldCore` forwards to these.
 
-#include "statsim/world_checks.hpp"
-#include "statsim/world_data.hpp"
+#include "statsim/detail/checks.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <cstdint>
 #include <limits>

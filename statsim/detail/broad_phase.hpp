@@ -1,10 +1,12 @@
 #pragma once
 /// @file
 /// The broad phase of a step: candidate pairs of bodies whose spheres of `pair_radius` overlap,
-/// from the hashed grid or sweep-and-prune (`broadphase.hpp`), into the world's pair buffer.
+/// from the hashed grid (grid.hpp) or sweep-and-prune (sweep.hpp), into the world's pair buffer.
 /// Pairs with a sleeping body are found only from the awake one; two sleepers are never a pair.
 
-#include "statsim/world_data.hpp"
+#include "statsim/detail/query_index.hpp"
+#include "statsim/detail/workers.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -13,6 +15,16 @@
 
 namespace statsim {
 namespace detail {
+
+/// A new candidate pair of bodies a < b, as the broad phases make it.
+inline Pair make_pair(std::uint32_t a, std::uint32_t b)
+{
+  Pair p;
+  p.a = a;
+  p.b = b & 0xffffffu;
+  p.witness = 0;
+  return p;
+}
 
 /// Records a candidate pair if the spheres of their `pair_radius` overlap, as the grid finds
 /// them; counts it either way it fits. The bounding spheres are tested first: most pairs of a
@@ -33,69 +45,6 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_
   if (d2 > reach * reach) return;
   if (found < w.max_pairs) w.pairs[found] = a < b ? make_pair(a, b) : make_pair(b, a);
   ++found;
-}
-
-/// Notes that the broad phase has just made a record of every body where it is now.
-template <int D>
-void made_records(WorldData<D>& w, bool grid)
-{
-  QueryIndex& q = w.index;
-  q.valid = true;
-  q.grid = grid;
-  q.overflow = false;
-  q.axis = w.def.sweep_axis;
-  q.count = w.body_count;
-  q.moved_count = 0;
-  q.drift = 0;
-  q.step = w.step_count;
-}
-
-/// After the contact passes: widens `QueryIndex::drift` to the farthest a body has moved from its
-/// record. Only bodies awake at some time in the step move (a sleeper's inverse mass is 0 in the
-/// passes): those awake now and those that fell asleep in it (`flagged`). The records are read
-/// in their own order, at one bit test each, so a step costs one read of them; it is made only
-/// in steps that made them (in others no body is awake and none moved).
-/// A body gone non-finite is left out: no query can meet it. (The bounds are measured on the
-/// same float sums the records were made of; the queries' margin covers the rest of the rounding.)
-template <int D>
-void measure_drift(WorldData<D>& w)
-{
-  QueryIndex& q = w.index;
-  if (!q.valid || w.step_count != q.step) return;
-  const auto moved = [&w](std::uint32_t i) {
-    const std::uint32_t bit = std::uint32_t(1) << (i % 32);
-    return ((w.awake[i / 32] | w.flagged[i / 32]) & bit) != 0 && finite(w.bodies[i].position);
-  };
-  Scalar drift = q.drift;
-  bool lost = false;
-  if (q.grid) {
-    for (std::uint32_t k = 0; k < q.count; ++k) {
-      const GridItem<D>& it = w.grid.items[k];
-      const std::uint32_t i = it.key & ~asleep_key;
-      if (!moved(i)) continue;
-      const Scalar d = (w.bodies[i].position - it.position).norm();
-      if (d > drift) drift = d;
-      else lost = lost || !(d <= drift);  // a record not finite: queries scan
-    }
-  } else {
-    const Scalar common = w.common_bound;
-    for (std::uint32_t k = 0; k < q.count; ++k) {
-      const SweepEntry& e = w.entries[k];
-      // An entry of a body gone non-finite leaves the entries out of order, where the queries'
-      // binary search would miss others: it makes the drift non-finite, and queries scan.
-      lost = lost || !(e.lo <= e.hi);
-      if (!moved(e.body)) continue;
-      const Body<D>& b = w.bodies[e.body];
-      // The entry's interval against the one the body would have now: the larger shift of its ends.
-      const Scalar bound = common > 0 ? common : w.shapes[b.shape].bounding_radius;
-      const Scalar lo = std::fabs(b.position[q.axis] - bound - e.lo);
-      const Scalar hi = std::fabs(b.position[q.axis] + bound - e.hi);
-      const Scalar d = lo > hi ? lo : hi;
-      if (d > drift) drift = d;
-      else lost = lost || !(d <= drift);  // a record not finite: queries scan
-    }
-  }
-  q.drift = lost ? std::numeric_limits<Scalar>::quiet_NaN() : drift;
 }
 
 /// What the grid's pair search of one step reads besides the grid: fixed once the grid is built.

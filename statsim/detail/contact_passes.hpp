@@ -23,11 +23,13 @@
 /// sideways and upward out of a packed pile each step, and the lift comes back as kinetic
 /// energy, so the pile never sleeps.
 
-#include "statsim/hull_contact.hpp"
-#include "statsim/slope_contact.hpp"
-#include "statsim/tipping.hpp"
-#include "statsim/workers.hpp"
-#include "statsim/world_data.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/response.hpp"
+#include "statsim/detail/slope.hpp"
+#include "statsim/detail/slope_contact.hpp"
+#include "statsim/detail/tipping.hpp"
+#include "statsim/detail/workers.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <algorithm>
 #include <array>
@@ -63,7 +65,7 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
   const Scalar threshold = restitution_threshold(w, b, n, ctx.dt);
   const bool resting = -v.dot(n) <= threshold;
   // On a slope a body with no rest pose meets the plane with its hull, as a rigid body does, its
-  // impacts included (statsim/slope_contact.hpp): how far it tumbles and rolls downhill follows
+  // impacts included (statsim/detail/slope_contact.hpp): how far it tumbles and rolls downhill follows
   // from the strikes of its faces one after the other, each set by the last, which independent
   // samples of the tables' single-impact responses do not reproduce. A body that rolled through
   // the step in substeps (`roll_on_slopes`) has had its slope contacts there.

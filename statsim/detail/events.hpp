@@ -5,8 +5,9 @@
 /// `MaxImpacts`). Recording only reads the world, before the impact pass responds to anything:
 /// a world steps to the same bits whether it records or not.
 
-#include "statsim/hull_contact.hpp"
-#include "statsim/world_data.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/slope.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <cstdint>
 

@@ -13,7 +13,7 @@
 /// slot), are tested one by one. What is found is only a candidate: the query then tests the
 /// body as it is now, with the same arithmetic as a test of every slot, so the hits are the same.
 
-#include "statsim/world_data.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <cmath>
 #include <cstdint>

@@ -4,9 +4,10 @@
 /// (radii the broad phase must hold, the radius at rest on other bodies, the hull's bounds), and
 /// `detail::support_bounds`, which the gatherers use too.
 
-#include "statsim/hull_contact.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/state_hash.hpp"
+#include "statsim/detail/world_data.hpp"
 #include "statsim/signature.hpp"
-#include "statsim/world_data.hpp"
 #include "statsim/world_def.hpp"
 
 #include <cmath>

@@ -4,10 +4,11 @@
 /// (paper 3.3.1), and at its end the resting conditions (paper 3.4) and the motion states
 /// (moving, settling, asleep).
 
-#include "statsim/hull_contact.hpp"
-#include "statsim/slope_contact.hpp"
-#include "statsim/tipping.hpp"
-#include "statsim/world_data.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/slope.hpp"
+#include "statsim/detail/slope_contact.hpp"
+#include "statsim/detail/tipping.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <cstdint>
 #include <limits>
@@ -106,94 +107,6 @@ void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground
   }
 }
 
-/// On a ground plane of unit normal `n` that gravity pulls bodies along (`downhill`, and
-/// `slope` = |g_t| / |g.n| = tan of the tilt a): whether rest pose `pose` of a body of shape
-/// `shape`, turned from `orientation` into the pose against the plane, fails to hold it. A rigid
-/// body stands on its support set, the face under it; the line of gravity through its centre
-/// meets the plane h tan(a) downhill of the point under the centre (h the support toward the
-/// plane), and the body tips over the face's downhill edge once that point is beyond the edge:
-/// e < h tan(a), e the face's extent downhill (`support_extent`). The tilt at which a pose stops
-/// holding, atan(e / h), thus depends on the direction the slope falls in the body's frame, and
-/// is read from the support map: no table holds it. The shape must have a support map.
-template <int D>
-bool pose_tips(const Shape<D>& shape, const typename Space<D>::Rot& orientation, std::uint32_t pose,
-               const typename Space<D>::Vec& n, const typename Space<D>::Vec& downhill, Scalar slope)
-{
-  using Vec = typename Space<D>::Vec;
-  const SignatureView<D>& sig = shape.signature;
-  const typename Space<D>::Rot at_rest = snap_to_rest(orientation, sig.rest.normal(pose), n);
-  const Vec down = to_body(at_rest, Vec(-n));
-  const Scalar h = support_along(sig.contact, down);
-  return h * slope > support_extent(shape, down, to_body(at_rest, downhill), h);
-}
-
-/// What `settle_on_slope` decided for a body settling on a tilted ground plane.
-enum class SlopeSettle {
-  pose,     ///< it settles as on level ground, in its pose or the nearest that holds it
-  tipping,  ///< it tips on: no pose, no sleep in this step
-  held,     ///< no pose holds it, but what it stands on does: no pose, it may sleep where it is
-};
-
-/// A statistical body settling on a tilted ground plane of unit normal `n`: a pose that does not
-/// hold it there (`pose_tips`) is no rest pose. Its pose (the chosen one, else the nearest) is
-/// kept where it holds. Else, where the line of gravity passes downhill of the support set the
-/// body stands on now, it tips over that set's downhill edge (`tip_over`) toward the next pose
-/// downhill and takes none; where that set holds it, it settles into the nearest pose that
-/// holds on this plane, or, with none, stays where it is (it may sleep there, as a body propped
-/// out of its poses). Level ground (no pull along it) never gets here: its bits are unchanged.
-template <int D>
-SlopeSettle settle_on_slope(const WorldData<D>& w, Body<D>& b, const typename Space<D>::Vec& n)
-{
-  using Vec = typename Space<D>::Vec;
-  const Shape<D>& shape = w.shapes[b.shape];
-  const SignatureView<D>& sig = shape.signature;
-  const WorldDef<D>& def = w.def;
-  if (!shape.statistical || !def.rest_conditions || sig.rest.count == 0 || !sig.contact.present())
-    return SlopeSettle::pose;
-  const Scalar gn = def.gravity.dot(n);
-  const Vec gt = def.gravity - n * gn;
-  const Scalar pull = gt.norm();
-  if (!(gn < 0) || !(pull > 0)) return SlopeSettle::pose;
-  const Vec downhill = gt / pull;
-  const Scalar slope = pull / -gn;
-  const Scalar* bias = shape.rest_bias.data();
-  const std::uint32_t pose =
-      b.rest_pose != no_rest_pose ? b.rest_pose : nearest_rest_pose<D>(sig, b.orientation, n, bias);
-  if (pose >= sig.rest.count || !pose_tips(shape, b.orientation, pose, n, downhill, slope)) return SlopeSettle::pose;
-  // The support set it stands on now: the line of gravity meets the plane h tan(a) downhill of
-  // the point under the centre; beyond the set's downhill extent e the body turns about the
-  // set's edge, e downhill of that point.
-  const Vec down = to_body(b.orientation, Vec(-n));
-  const Scalar h = support_along(sig.contact, down);
-  const Scalar e = support_extent(shape, down, to_body(b.orientation, downhill), h);
-  // A tip slower than the sleep speed (the body near balance over the edge: on a curved part of
-  // its hull it rolls until the line of gravity meets the point it stands on) counts as held.
-  const Scalar g = def.gravity.norm();
-  if (h * slope > e) {
-    const Scalar spin = tip_over(shape, b, Vec(b.position - n * h + downhill * e), Vec(def.gravity / g), g,
-                                 def.settle_speed);
-    if (spin * shape.bounding_radius >= def.sleep_speed) {
-      b.rest_pose = no_rest_pose;
-      b.rest_blend = 0;
-      return SlopeSettle::tipping;
-    }
-  }
-  // Held where it stands: the nearest pose among those that hold (the score of
-  // `nearest_rest_pose`); a new pose starts its radius blend afresh.
-  std::uint32_t best = no_rest_pose;
-  Scalar best_score = -std::numeric_limits<Scalar>::infinity();
-  for (std::uint32_t i = 0; i < sig.rest.count; ++i) {
-    const Scalar score = (b.orientation * sig.rest.normal(i)).dot(n) + bias[i];
-    if (score > best_score && !pose_tips(shape, b.orientation, i, n, downhill, slope)) {
-      best_score = score;
-      best = i;
-    }
-  }
-  if (best != b.rest_pose) b.rest_blend = 0;
-  b.rest_pose = std::uint8_t(best);
-  return best == no_rest_pose ? SlopeSettle::held : SlopeSettle::pose;
-}
-
 /// True when the chosen rest pose's normal is within `rest_snap_cosine` of the ground's normal.
 template <int D>
 bool in_rest_pose(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& ground)
@@ -227,7 +140,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
     const bool settling = b.touching && speed2 < settle2;
     const Vec ground = settling && b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
     // On a slope a pose steeper than its tipping angle is no rest pose (`settle_on_slope`).
-    // A body rolling on its hull down a slope (statsim/slope_contact.hpp) takes a pose only once
+    // A body rolling on its hull down a slope (statsim/detail/slope_contact.hpp) takes a pose only once
     // its contacts have all but stopped it there: the faces it rolls over are not poses it rests in.
     const bool rolling = tilted_planes && settling && b.on_ground && speed2 >= sleep2 && rolls_on(w, b, ground);
     const SlopeSettle slope = rolling                                   ? SlopeSettle::tipping

@@ -4,7 +4,7 @@
 /// bounds-checked reading of integers and of the IEEE bits of scalars, the checksum, and the
 /// fingerprint of a shape. Nothing here knows the layout of a snapshot.
 
-#include "statsim/world_data.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -8,8 +8,9 @@
 /// body is held (`mark_supports`) and then tips the bodies that are held from one side only
 /// (`tip_unsupported`).
 
-#include "statsim/hull_contact.hpp"
-#include "statsim/world_data.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/slope.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <array>
 #include <cmath>

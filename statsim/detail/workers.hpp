@@ -1,15 +1,34 @@
 #pragma once
 /// @file
-/// Work of a step that runs on the user's workers (`WorldDef::workers`) besides the grid's pair
-/// search (find_pairs.hpp): the impact pass's search of the pairs' hull candidates.
+/// The user's workers (`WorldDef::workers`): how a step hands them a job (`run_on_workers`), and
+/// the impact pass's search of the pairs' hull candidates on them. The other job they take, the
+/// grid's pair search in parts, is in broad_phase.hpp beside the search it cuts up.
 
-#include "statsim/hull_contact.hpp"
-#include "statsim/world_data.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <cstdint>
 
 namespace statsim {
 namespace detail {
+
+/// Runs `task(begin, end, context)` over the items [0, count): in ranges of at least `min_range`
+/// items on the world's workers, about four per worker (items differ in cost, and a worker done
+/// early takes another range), or at once on the calling thread when there are no workers or too
+/// few items to share (handing out a task costs a thread's wake-up, tens of microseconds).
+template <int D>
+void run_on_workers(const WorldData<D>& w, std::uint32_t count, std::uint32_t min_range, TaskCallback* task,
+                    void* context)
+{
+  const Workers& k = w.def.workers;
+  const std::uint32_t range = std::uint32_t((std::uint64_t(count) + 4 * k.count - 1) / (4 * k.count));
+  if (k.count < 2 || count < 2 * min_range) {
+    task(0, count, context);
+    return;
+  }
+  void* handle = k.enqueue(task, count, range > min_range ? range : min_range, context, k.context);
+  if (handle != nullptr) k.finish(handle, k.context);
+}
 
 /// The fewest pairs worth a part of their own (a few tenths of a millisecond of searching).
 constexpr std::uint32_t witnesses_per_part = 512;

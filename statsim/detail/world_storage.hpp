@@ -2,8 +2,8 @@
 /// @file
 /// `detail::WorldStorage`: every array of a `World<>`, sized by its template arguments.
 
-#include "statsim/events.hpp"
-#include "statsim/world_data.hpp"
+#include "statsim/detail/events.hpp"
+#include "statsim/detail/world_data.hpp"
 
 #include <array>
 #include <cstddef>

@@ -12,9 +12,9 @@
 #include "ref2d/compare2d.hpp"
 
 #include "common/support_map.hpp"
-#include "statsim/hull_contact.hpp"
-#include "statsim/shape_setup.hpp"
-#include "statsim/response.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/shape_setup.hpp"
+#include "statsim/detail/response.hpp"
 #include "statsim/statistical.hpp"
 
 #include <CLI/CLI.hpp>

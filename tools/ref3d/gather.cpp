@@ -8,9 +8,9 @@
 #include "common/table_writer.hpp"
 #include "ref3d/pairs.hpp"
 #include "ref3d/sampling.hpp"
-#include "statsim/hull_contact.hpp"
-#include "statsim/shape_setup.hpp"
-#include "statsim/response.hpp"
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/shape_setup.hpp"
+#include "statsim/detail/response.hpp"
 #include "statsim/signature.hpp"
 #include "statsim/statistical.hpp"
 

@@ -1,0 +1,92 @@
+#pragma once
+/// @file
+/// Which contacts with planes a body meets at its hull rather than its collision sphere: a
+/// tilted plane (`is_tilted_plane`) for a statistical body with a support map (`slope_hull`),
+/// and a settling body with hull contacts (`hull_radius`). What happens at those contacts is
+/// slope_contact.hpp's.
+
+#include "statsim/detail/hull.hpp"
+#include "statsim/detail/narrow_phase.hpp"
+#include "statsim/detail/world_data.hpp"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace statsim {
+namespace detail {
+
+/// True when the plane of unit normal `n` is tilted: it carries weight (n.g < 0) and gravity
+/// `g` pulls along it (a part that is not exactly zero). Writes g.n to `gn`.
+template <class Vec>
+bool is_tilted_plane(const Vec& g, const Vec& n, Scalar& gn)
+{
+  gn = g.dot(n);
+  return gn < 0 && (g - n * gn).squaredNorm() > 0;
+}
+
+/// True when some plane is tilted (`WorldData::tilted_planes`, set as planes are added).
+template <int D>
+bool any_tilted_plane(const WorldData<D>& w)
+{
+  Scalar gn;
+  for (std::uint32_t p = 0; p < w.plane_count; ++p)
+    if (is_tilted_plane(w.def.gravity, w.planes[p].normal, gn)) return true;
+  return false;
+}
+
+/// True when body `b` meets the plane of unit normal `n` with its hull, as a rigid body would
+/// (statsim/detail/slope_contact.hpp): the plane is tilted (`is_tilted_plane`) and the body statistical,
+/// with a support map and principal moments. On level ground and walls bodies keep their
+/// collision spheres.
+template <int D>
+bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  if (!w.tilted_planes) return false;
+  const Shape<D>& s = w.shapes[b.shape];
+  if (!s.statistical || !s.signature.contact.present()) return false;
+  for (int k = 0; k < (D == 3 ? 3 : 1); ++k)
+    if (!(s.signature.unit_inertia[std::size_t(k)] > 0)) return false;
+  Scalar gn;
+  return is_tilted_plane(w.def.gravity, n, gn);
+}
+
+/// True when body `b` meets a plane of unit normal `n` (towards the body) with its hull
+/// (`slope_hull`) and has no rest pose chosen: its contacts there are `slope_hull_response`'s.
+template <int D>
+bool rolls_on(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  return b.rest_pose == no_rest_pose && slope_hull(w, b, n);
+}
+
+/// The radius a body keeps from a plane of normal `n`: its collision radius, or its hull's
+/// support toward the plane on a slope (`slope_hull`), or, for a settling body with a hull
+/// (`BodyContacts::hulls`), at least its hull's support toward the plane, so that a body resting
+/// out of its rest poses (propped by others) does not sink its hull into the ground or a wall.
+template <int D>
+Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  const Shape<D>& s = w.shapes[b.shape];
+  if (slope_hull(w, b, n))
+    return support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
+  if (w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling || !s.statistical ||
+      !s.signature.contact.present())
+    return b.radius;
+  const Scalar hull = support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
+  return hull > b.radius ? hull : b.radius;
+}
+
+/// `hull_radius` against a plane, where it matters: the support is read only when the plane is
+/// within the body's bounding radius.
+template <int D>
+Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& plane)
+{
+  // `hull_radius`'s first tests, before the plane's distance: every body meets every plane in
+  // every pass, and most need neither.
+  if (!w.tilted_planes && (w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling))
+    return b.radius;
+  if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
+  return hull_radius(w, b, plane.normal);
+}
+
+}  // namespace detail
+}  // namespace statsim
