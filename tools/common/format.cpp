@@ -5,6 +5,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 
 namespace statsim::tools {
 
@@ -37,6 +38,15 @@ std::string num(double x)
     if (std::strtod(buf, nullptr) == x) break;
   }
   return buf;
+}
+
+std::vector<std::string> split_list(const std::string& s)
+{
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(item);
+  return out;
 }
 
 }  // namespace statsim::tools

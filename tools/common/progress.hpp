@@ -9,6 +9,12 @@
 
 namespace statsim::tools {
 
+/// Seconds of wall time since `t0` (the timings the tools report beside their results).
+inline double seconds_since(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 /// Reports "label: done/total (pct) elapsed 12.3s, ETA 45s" on stderr.
 ///
 /// When stderr is a terminal, one line is rewritten in place (carriage return) at most ten

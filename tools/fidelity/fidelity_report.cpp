@@ -3,6 +3,7 @@
 #include "common/commands.hpp"
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 #include "common/plot.hpp"
 
 #include <CLI/CLI.hpp>
@@ -527,20 +528,12 @@ void register_fidelity_commands(CLI::App& app)
     FidelityOptions o = *opts;
     o.piles = !*no_piles;
     o.drops = !*scenes_only;
-    if (!scene_list->empty()) {
-      std::stringstream ss(*scene_list);
-      std::string k;
-      while (std::getline(ss, k, ','))
-        if (!k.empty()) o.scenes.push_back(k);
-    }
+    for (const std::string& k : split_list(*scene_list))
+      if (!k.empty()) o.scenes.push_back(k);
     o.timing = !*no_timing;
     o.progress = !*quiet;
-    if (!method_list->empty()) {
-      std::stringstream ss(*method_list);
-      std::string m;
-      while (std::getline(ss, m, ','))
-        if (!m.empty()) o.methods.push_back(m);
-    }
+    for (const std::string& m : split_list(*method_list))
+      if (!m.empty()) o.methods.push_back(m);
     for (const std::string& t : *table_args) {
       const auto eq = t.find('=');
       if (eq == std::string::npos || eq == 0 || eq + 1 == t.size())

@@ -247,7 +247,7 @@ Fig3Result run_fig3(const Fig3Options& options)
   }
   d.mean_skin_gap = d.skin_reports > 0 ? gap_sum / static_cast<double>(d.skin_reports) : 0.0;
   d.mean_naive_bias = bias_sum / static_cast<double>(total);
-  d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  d.seconds = seconds_since(start);
   return result;
 }
 

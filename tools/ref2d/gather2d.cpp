@@ -427,7 +427,7 @@ void rest_experiment(const Context& ctx, Gather2dResult& r)
     r.rest_time_limited += t.settled ? 0 : 1;
   }
   cluster_rest_poses(r);
-  r.seconds_rest = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.seconds_rest = seconds_since(start);
 }
 
 void warm_up_box2d(const Context& ctx)
@@ -595,7 +595,7 @@ void body_contacts_experiment(const Context& ctx, Gather2dResult& r)
   c.pair_mean = pd.mean;
   c.pair_std = pd.std;
   c.pair_flights = pd.flights;
-  c.pair_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  c.pair_seconds = seconds_since(t0);
 
   std::vector<Eigen::Vector2d> hull;
   for (const Point2& p : sh.hull) hull.emplace_back(p.x, p.y);
@@ -656,7 +656,7 @@ void body_contacts_experiment(const Context& ctx, Gather2dResult& r)
     }
   }
   packing_statistics(samples, c);
-  c.packing_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  c.packing_seconds = seconds_since(t1);
 }
 
 }  // namespace
@@ -701,7 +701,7 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
       row.trials = static_cast<int>(per);
       r.heights.push_back(row);
     }
-    r.seconds_heights = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.seconds_heights = seconds_since(start);
   }
 
   // 2. Response tables.
@@ -745,7 +745,7 @@ Gather2dResult run_gather2d(const Gather2dOptions& options)
       r.response_time_limited += c.time_limited;
       r.cells.push_back(c);
     }
-    r.seconds_responses = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.seconds_responses = seconds_since(start);
   }
 
   // 3. Rest poses.
@@ -1079,7 +1079,7 @@ void run_gather2d_command(Gather2dCommand& cmd)
       write_file_atomic(cmd.json, gather2d_json(r, command));
     }
     std::fputs(gather2d_summary(r).c_str(), stdout);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = seconds_since(start);
     std::printf("wrote %s (%zu bytes) in %.1f s\n", out.c_str(), header.size(), seconds);
     std::fflush(stdout);
   } catch (const std::exception& e) {

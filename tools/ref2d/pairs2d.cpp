@@ -3,6 +3,7 @@
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
 #include "common/parallel.hpp"
+#include "common/progress.hpp"
 #include "common/support_map.hpp"
 #include "ref2d/box2d_util.hpp"
 #include "ref2d/compare2d.hpp"
@@ -110,11 +111,6 @@ double flight(const std::vector<Eigen::Vector2d>& poly, double L, double spin_ra
     t += d / rate;
   }
   return (b.c - a.c).norm();
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 double mean_of(const std::vector<double>& v)

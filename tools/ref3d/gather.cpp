@@ -32,11 +32,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Random streams (TrialRng's `stream`): one per kind of trial.
-constexpr std::uint64_t kHeightStream = 1;
-constexpr std::uint64_t kResponseStream = 2;
-constexpr std::uint64_t kRestStream = 3;
-constexpr std::uint64_t kCheckStream = 5;
 // Rest normals within this angle of a hull face's are snapped to it.
 constexpr double kSnapDegrees = 3.0;
 // Packing bins are as wide as gather-pairs' `--bin 2.2`: walls 4.4 L apart, 2 x 2 bodies a layer.
@@ -97,11 +92,6 @@ Stats stats(std::size_t n, Get&& get)
   }
   s.std = std::sqrt(sq / static_cast<double>(n - 1));
   return s;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 bool strictly_increasing(const std::vector<double>& v)

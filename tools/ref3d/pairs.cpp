@@ -6,6 +6,7 @@
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
 #include "common/support_map.hpp"
+#include "ref3d/reference.hpp"
 #include "ref3d/sampling.hpp"
 #include "scenes/scenes.hpp"
 #include "statsim/world3.hpp"
@@ -30,15 +31,6 @@ namespace statsim::tools::ref3d {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// Random streams (TrialRng's `stream`), apart from gather's.
-constexpr std::uint64_t kPairStream = 11;
-constexpr std::uint64_t kPairHeightStream = 12;
-constexpr std::uint64_t kBinStream = 16;
-
-double seconds_since(std::chrono::steady_clock::time_point t0)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 btTransform to_bt(const RigidState& s)
 {
@@ -246,15 +238,7 @@ PairOutcome bullet_pair_impact(const ShapeModel& m, btCollisionShape* shape, con
   btSequentialImpulseConstraintSolver solver;
   btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
   world.setGravity(btVector3(0, 0, 0));
-  btContactSolverInfo& info = world.getSolverInfo();
-  info.m_numIterations = rs.solver_iterations;
-  info.m_restitutionVelocityThreshold = rs.restitution_threshold;
-  info.m_splitImpulse = rs.split_impulse ? 1 : 0;
-  info.m_splitImpulsePenetrationThreshold = rs.split_impulse ? 1e30 : -0.04;
-  info.m_erp = rs.erp;
-  info.m_erp2 = rs.erp;
-  info.m_linearSlop = 0.0;
-  info.m_solverMode = SOLVER_USE_2_FRICTION_DIRECTIONS | (rs.warm_starting ? SOLVER_USE_WARMSTARTING : 0);
+  apply_solver_settings(world.getSolverInfo(), rs);
   std::unique_ptr<btRigidBody> body[2];
   for (int k = 0; k < 2; ++k) {
     const RigidState& st = k ? s.second : s.first;

@@ -14,6 +14,18 @@ std::string bullet_version()
   return std::to_string(v / 100) + "." + std::to_string(v % 100);
 }
 
+void apply_solver_settings(btContactSolverInfo& info, const ReferenceSettings& s)
+{
+  info.m_numIterations = s.solver_iterations;
+  info.m_restitutionVelocityThreshold = s.restitution_threshold;
+  info.m_splitImpulse = s.split_impulse ? 1 : 0;
+  info.m_splitImpulsePenetrationThreshold = s.split_impulse ? 1e30 : -0.04;
+  info.m_erp = s.erp;
+  info.m_erp2 = s.erp;
+  info.m_linearSlop = 0.0;
+  info.m_solverMode = SOLVER_USE_2_FRICTION_DIRECTIONS | (s.warm_starting ? SOLVER_USE_WARMSTARTING : 0);
+}
+
 namespace {
 
 using bullet::to_bt;
@@ -64,15 +76,7 @@ struct Reference::Impl {
     auto w = std::make_unique<World>(&config);
     btGImpactCollisionAlgorithm::registerAlgorithm(&w->dispatcher);
     w->world.setGravity(btVector3(0, 0, -gravity));
-    btContactSolverInfo& info = w->world.getSolverInfo();
-    info.m_numIterations = s.solver_iterations;
-    info.m_restitutionVelocityThreshold = s.restitution_threshold;
-    info.m_splitImpulse = s.split_impulse ? 1 : 0;
-    info.m_splitImpulsePenetrationThreshold = s.split_impulse ? 1e30 : -0.04;
-    info.m_erp = s.erp;
-    info.m_erp2 = s.erp;
-    info.m_linearSlop = 0.0;
-    info.m_solverMode = SOLVER_USE_2_FRICTION_DIRECTIONS | (s.warm_starting ? SOLVER_USE_WARMSTARTING : 0);
+    apply_solver_settings(w->world.getSolverInfo(), s);
 
     // Ground: static, restitution 1 and friction 1, so the combined values (Bullet multiplies)
     // are the body's.

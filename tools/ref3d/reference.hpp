@@ -7,6 +7,8 @@
 #include <memory>
 #include <string>
 
+struct btContactSolverInfo;
+
 namespace statsim::tools::ref3d {
 
 /// Ground representation in Bullet.
@@ -51,6 +53,10 @@ struct ReferenceSettings {
   double gravity = 9.81;               ///< m/s^2, rest drops only
   double rest_rolling_friction = 0.0;  ///< m, Bullet's rolling and spinning friction, rest drops only
 };
+
+/// Puts `s` into a Bullet world's solver, so that the impacts of `statsim gather` and the pair
+/// impacts of `statsim gather-pairs` are solved alike.
+void apply_solver_settings(btContactSolverInfo& info, const ReferenceSettings& s);
 
 /// What an impact trial produced.
 struct ImpactResult {

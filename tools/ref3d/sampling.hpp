@@ -13,6 +13,18 @@
 
 namespace statsim::tools::ref3d {
 
+// TrialRng's `stream`, one per kind of trial, all here so that no two kinds share one (the
+// committed tables depend on each value). gather: heights, responses, rest drops, and the checks
+// (kCheckStream and kCheckStream + 1); gather-pairs: pair flights (kPairStream to
+// kPairStream + 3), their heights and the bins.
+constexpr std::uint64_t kHeightStream = 1;
+constexpr std::uint64_t kResponseStream = 2;
+constexpr std::uint64_t kRestStream = 3;
+constexpr std::uint64_t kCheckStream = 5;
+constexpr std::uint64_t kPairStream = 11;
+constexpr std::uint64_t kPairHeightStream = 12;
+constexpr std::uint64_t kBinStream = 16;
+
 /// xoshiro256** seeded through SplitMix64 from (seed, stream, index).
 class TrialRng {
 public:

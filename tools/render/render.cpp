@@ -1,5 +1,6 @@
 #include "render/render.hpp"
 
+#include "common/format.hpp"
 #include "common/parallel.hpp"
 #include "common/stb_wrapper.hpp"
 #include "mesh/mass.hpp"
@@ -135,9 +136,7 @@ bool load_render_shape(const std::string& name, const std::string& meshes_dir, R
 bool load_frames(const std::string& path, const std::string& shape_names, const std::string& detail,
                  const std::string& meshes_dir, LoadedFrames& out, std::string& error)
 {
-  std::vector<std::string> names;
-  std::stringstream list(shape_names);
-  for (std::string item; std::getline(list, item, ',');) names.push_back(item);
+  const std::vector<std::string> names = split_list(shape_names);
   if (!read_frames(path, names, out.frames, error)) return false;
   const int bodies = out.frames.body_count();
   for (const std::string& name : out.frames.shapes) {

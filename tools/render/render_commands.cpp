@@ -1,6 +1,7 @@
 #include "render/render.hpp"
 #include "common/commands.hpp"
 
+#include "common/format.hpp"
 #include "common/progress.hpp"
 #include "render/frames.hpp"
 #include "render/reference_run.hpp"
@@ -37,15 +38,6 @@ struct RenderArgs {
   double fit_share = 1.0;
   unsigned threads = 0;
 };
-
-std::vector<std::string> split_list(const std::string& s)
-{
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(item);
-  return out;
-}
 
 bool parse_numbers(const std::string& s, std::vector<double>& v)
 {
