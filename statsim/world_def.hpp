@@ -1,9 +1,9 @@
 #pragma once
 /// @file
 /// What a world is made of: the limits on inputs, the ids, the definitions users fill in
-/// (`ShapeDef`, `BodyDef`, `WorldDef`) and the state the world keeps (`Body`, `Shape`).
+/// (`ShapeDef`, `BodyDef`, `WorldDef` and its options), the state the world keeps (`Body`,
+/// `Shape`, `Plane`) and what a step leaves to read (`Pair`, `Impact`).
 
-#include "statsim/detail/narrow_phase.hpp"
 #include "statsim/statistical.hpp"
 #include "statsim/status.hpp"
 
@@ -169,6 +169,30 @@ struct Pair {
   /// With hull contacts, the candidate normal the impact pass found for a touching pair
   /// (`detail::find_hull_witness`), which the later passes of the step reuse; 0 in a new pair.
   std::uint32_t witness : 8;
+};
+
+/// A static plane (a line in 2D): the points x with normal . x = offset, solid on the side
+/// normal . x < offset.
+template <int D>
+struct Plane {
+  typename Space<D>::Vec normal;  ///< unit, pointing out of the solid side
+  Scalar offset;                  ///< m
+};
+
+/// One impact of the last step, as the impact pass met it: before any response of the step.
+template <int D>
+struct Impact {
+  using Vec = typename Space<D>::Vec;
+  BodyId a;       ///< the (first) body
+  BodyId b;       ///< the other body, or `no_body` for an impact with plane `plane`
+  PlaneId plane;  ///< meaningful when b == no_body
+  /// Contact point, m: the foot of a's centre on the plane; between two bodies, on the line of
+  /// their centres, dividing it in the ratio of their collision radii.
+  Vec point;
+  /// Unit normal: from a towards b; with a plane, the plane's normal (out of it, towards a).
+  Vec normal;
+  /// Speed at which the bodies approach along the normal, m/s (> `WorldDef::impact_threshold`).
+  Scalar approach_speed;
 };
 
 /// Where two bodies touch (see statsim/detail/hull.hpp).

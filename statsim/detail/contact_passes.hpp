@@ -24,6 +24,7 @@
 /// energy, so the pile never sleeps.
 
 #include "statsim/detail/hull.hpp"
+#include "statsim/detail/narrow_phase.hpp"
 #include "statsim/detail/response.hpp"
 #include "statsim/detail/slope.hpp"
 #include "statsim/detail/slope_contact.hpp"

@@ -6,29 +6,13 @@
 /// a world steps to the same bits whether it records or not.
 
 #include "statsim/detail/hull.hpp"
+#include "statsim/detail/narrow_phase.hpp"
 #include "statsim/detail/slope.hpp"
 #include "statsim/detail/world_data.hpp"
 
 #include <cstdint>
 
 namespace statsim {
-
-/// One impact of the last step, as the impact pass met it: before any response of the step.
-template <int D>
-struct Impact {
-  using Vec = typename Space<D>::Vec;
-  BodyId a;       ///< the (first) body
-  BodyId b;       ///< the other body, or `no_body` for an impact with plane `plane`
-  PlaneId plane;  ///< meaningful when b == no_body
-  /// Contact point, m: the foot of a's centre on the plane; between two bodies, on the line of
-  /// their centres, dividing it in the ratio of their collision radii.
-  Vec point;
-  /// Unit normal: from a towards b; with a plane, the plane's normal (out of it, towards a).
-  Vec normal;
-  /// Speed at which the bodies approach along the normal, m/s (> `WorldDef::impact_threshold`).
-  Scalar approach_speed;
-};
-
 namespace detail {
 
 /// The impact buffer of a world and what the last step put in it.

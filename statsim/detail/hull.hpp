@@ -31,6 +31,7 @@
 /// square root beyond |c_b - c_a|. A plain sphere of radius r takes part with s(u) = r and no
 /// faces, which is exact for a sphere against a hull.
 
+#include "statsim/detail/narrow_phase.hpp"
 #include "statsim/detail/world_data.hpp"
 
 #include <cmath>

@@ -4,16 +4,9 @@
 /// serves both), giving the collision-plane normal of paper 3.3.2 step 1 and the overlap depth.
 
 #include "statsim/math.hpp"
+#include "statsim/world_def.hpp"
 
 namespace statsim {
-
-/// A static plane (a line in 2D): the points x with normal . x = offset, solid on the side
-/// normal . x < offset.
-template <int D>
-struct Plane {
-  typename Space<D>::Vec normal;  ///< unit, pointing out of the solid side
-  Scalar offset;                  ///< m
-};
 
 /// A touching pair: the collision-plane normal and how far the spheres overlap.
 template <int D>

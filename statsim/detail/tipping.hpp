@@ -9,6 +9,7 @@
 /// (`tip_unsupported`).
 
 #include "statsim/detail/hull.hpp"
+#include "statsim/detail/narrow_phase.hpp"
 #include "statsim/detail/slope.hpp"
 #include "statsim/detail/world_data.hpp"
 
