@@ -9,6 +9,8 @@
 
 #include <doctest/doctest.h>
 
+#include "support/csv.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -37,32 +39,7 @@ bool same(const scenes::BodyState3& a, const scenes::BodyState3& b)
          a.linear_velocity == b.linear_velocity && a.angular_velocity == b.angular_velocity;
 }
 
-// Splits a CSV line into fields (double quotes protect commas; "" is a quote).
-std::vector<std::string> csv_fields(const std::string& line)
-{
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        out.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        out.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.emplace_back();
-    } else {
-      out.back() += c;
-    }
-  }
-  return out;
-}
+using statsim::testing::csv_fields;
 
 std::string read_file(const std::filesystem::path& path)
 {

@@ -5,6 +5,8 @@
 // examples/web/size.csv; the firmware's footprint table). Runs in the repository root.
 #include <doctest/doctest.h>
 
+#include "support/csv.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -41,31 +43,7 @@ std::vector<std::string> lines_of(const std::string& text)
 
 // ---- CSV --------------------------------------------------------------------------------------
 
-std::vector<std::string> csv_fields(const std::string& line)
-{
-  std::vector<std::string> fields(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        fields.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        fields.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.emplace_back();
-    } else if (c != '\r') {
-      fields.back() += c;
-    }
-  }
-  return fields;
-}
+using statsim::testing::csv_fields;
 
 using Row = std::map<std::string, std::string>;
 
