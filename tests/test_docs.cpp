@@ -2,7 +2,8 @@
 // resolves, README.md's headline numbers equal the committed measurement files they come from
 // (examples/images/bench.csv, examples/images/footprint.csv, tools/fidelity/figures.csv,
 // tools/ref2d/figures.csv), and so do the documented sizes (the web page's files,
-// examples/web/size.csv; the firmware's footprint table). Runs in the repository root.
+// examples/web/size.csv; the firmware's footprint table); every chapter README under tools/ and
+// examples/ keeps to its length. Runs in the repository root.
 #include <doctest/doctest.h>
 
 #include "support/csv.hpp"
@@ -502,3 +503,22 @@ TEST_CASE("docs: tests/README.md names every file of tests/")
   CHECK(files > 50);
 }
 
+
+TEST_CASE("docs: every chapter README under tools/ and examples/ has at most 300 lines")
+{
+  // The project's rule: a chapter holds today's content; what was measured before goes to the
+  // dated LOG.md beside it.
+  constexpr std::size_t max_lines = 300;
+  std::vector<fs::path> chapters{"examples/README.md"};
+  for (const fs::path dir : {"tools", "examples"})
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.is_directory() && fs::exists(entry.path() / "README.md"))
+        chapters.push_back((entry.path() / "README.md").lexically_normal());
+  std::sort(chapters.begin(), chapters.end());
+  for (const auto& chapter : chapters) {
+    const std::size_t n = lines_of(read_text(chapter)).size();
+    CHECK_MESSAGE(n <= max_lines, chapter.generic_string() << " has " << n << " lines, more than " << max_lines
+                                                            << ": move what is superseded to the LOG.md beside it");
+  }
+  CHECK(chapters.size() > 5);
+}
