@@ -177,8 +177,10 @@ void overlap_sphere_scan(const WorldData<D>& w, const typename Space<D>::Vec& ce
 }
 
 template <int D>
-Status check_query(const typename Space<D>::Vec& origin, const typename Space<D>::Vec& v, Scalar length)
+Status check_query(const WorldCore<D>& world, const typename Space<D>::Vec& origin, const typename Space<D>::Vec& v,
+                   Scalar length)
 {
+  if (!includes(world.features(), Features::queries)) return Status::not_compiled;
   if (!finite(origin) || !finite(v) || !finite(length)) return Status::non_finite;
   if (!within(origin, limits::coordinate) || !within(v, limits::coordinate) || !(length >= 0) ||
       length > limits::coordinate)
@@ -193,14 +195,15 @@ Status check_query(const typename Space<D>::Vec& origin, const typename Space<D>
 /// enters, bodies in slot order, then planes; `on_hit` returns false to stop. A ray that starts
 /// inside a sphere, or on the solid side of a plane, does not hit it. Returns `ok`;
 /// `non_finite`; `out_of_range` (beyond `limits::coordinate`, or a negative distance);
-/// `invalid_parameter` for a zero direction. `stats`, if given, is added what the query examined.
+/// `invalid_parameter` for a zero direction; `not_compiled` in a world without
+/// `Features::queries`. `stats`, if given, is added what the query examined.
 template <int D, class OnHit>
 Status ray_cast_all(const WorldCore<D>& world, const typename Space<D>::Vec& origin,
                     const typename Space<D>::Vec& direction, Scalar max_distance, OnHit&& on_hit,
                     QueryStats* stats = nullptr)
 {
   using Vec = typename Space<D>::Vec;
-  const Status s = detail::check_query<D>(origin, direction, max_distance);
+  const Status s = detail::check_query<D>(world, origin, direction, max_distance);
   if (s != Status::ok) return s;
   const Scalar len = direction.norm();
   if (!(len > Scalar(1e-12))) return Status::invalid_parameter;
@@ -234,7 +237,7 @@ Status ray_cast(const WorldCore<D>& world, const typename Space<D>::Vec& origin,
                 QueryStats* stats = nullptr)
 {
   using Vec = typename Space<D>::Vec;
-  const Status s = detail::check_query<D>(origin, direction, max_distance);
+  const Status s = detail::check_query<D>(world, origin, direction, max_distance);
   if (s != Status::ok) return s;
   const Scalar len = direction.norm();
   if (!(len > Scalar(1e-12))) return Status::invalid_parameter;
@@ -275,14 +278,14 @@ Status ray_cast(const WorldCore<D>& world, const typename Space<D>::Vec& origin,
 /// Calls `on_hit(const QueryHit<D>&)` for every body whose collision sphere overlaps the sphere
 /// of `radius` (m, >= 0) about `center` (m), in slot order, then every plane it reaches into;
 /// `on_hit` returns false to stop. Touching counts (a distance of 0). Returns `ok`, `non_finite`
-/// or `out_of_range` (beyond `limits::coordinate`, or a negative radius). `stats`, if given, is
-/// added what the query examined.
+/// `out_of_range` (beyond `limits::coordinate`, or a negative radius) or `not_compiled` (a world
+/// without `Features::queries`). `stats`, if given, is added what the query examined.
 template <int D, class OnHit>
 Status overlap_sphere(const WorldCore<D>& world, const typename Space<D>::Vec& center, Scalar radius, OnHit&& on_hit,
                       QueryStats* stats = nullptr)
 {
   using Vec = typename Space<D>::Vec;
-  const Status s = detail::check_query<D>(center, Vec::Zero(), radius);
+  const Status s = detail::check_query<D>(world, center, Vec::Zero(), radius);
   if (s != Status::ok) return s;
   const detail::WorldData<D>& w = world.data();
   QueryStats own;

@@ -274,6 +274,8 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
   const Status def_status = check_world_def(def);
   if (def_status != Status::ok) return def_status;
   if (def.broad_phase == BroadPhase::grid && !w.grid_storage) return Status::invalid_parameter;
+  if (def.body_contacts == BodyContacts::hulls && !includes(w.features, Features::hull_contacts))
+    return Status::not_compiled;
   // The widest diameter is that of some shape added (`add_body`), or 0 before any body.
   bool widest_known = widest == 0 && bodies == 0;
   for (std::uint32_t i = 0; i < shapes; ++i) {
@@ -304,6 +306,8 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
     if (!finite(p.normal) || !finite(p.offset) || !(std::fabs(p.normal.squaredNorm() - 1) < Scalar(2e-3)))
       return Status::invalid_plane;
     if (!within(p.offset, limits::coordinate)) return Status::out_of_range;
+    Scalar gn;
+    if (!includes(w.features, Features::slopes) && is_tilted_plane(def.gravity, p.normal, gn)) return Status::not_compiled;
     if (commit) w.planes[i] = p;
   }
   if (commit) w.tilted_planes = any_tilted_plane(w);
@@ -420,7 +424,8 @@ Status save(const WorldCore<D>& world, unsigned char* buf, std::size_t cap, std:
 /// neither overflows its pair buffer. Refused, changing no state, with `invalid_snapshot`
 /// (not a snapshot, truncated, too long, checksum wrong, a value no world can hold),
 /// `snapshot_incompatible` (another version, dimension or scalar width, or the other broad-phase
-/// storage), `shape_mismatch`, `capacity_exceeded` (more bodies or planes than the world holds),
+/// storage), `shape_mismatch`, `not_compiled` (hull contacts or a tilted plane in a world compiled
+/// without them, statsim/features.hpp), `capacity_exceeded` (more bodies or planes than the world holds),
 /// or the status a setter gives a value out of its range (`non_finite`, `out_of_range`,
 /// `non_unit_quaternion`, `invalid_parameter`...). Bodies beyond `limits` (one that fell far)
 /// are refused like such input: such a world saves but does not load.

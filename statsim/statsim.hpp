@@ -4,6 +4,7 @@
 /// comes in through them). tests/api/headers.cmake fails when a public header is missing here.
 
 #include "statsim/config.hpp"
+#include "statsim/features.hpp"
 #include "statsim/math.hpp"
 #include "statsim/mesh_pose.hpp"
 #include "statsim/queries.hpp"

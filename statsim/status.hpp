@@ -35,6 +35,10 @@ enum class [[nodiscard]] Status : std::uint8_t {
   snapshot_incompatible,
   /// Only from `load`: the world's shapes differ from the snapshot's (count, order or data).
   shape_mismatch,
+  /// The call asks for what the world's `Features` (its template parameter, statsim/features.hpp)
+  /// leave out: a statistical shape, hull contacts, a tilted plane, a query; from `load`, a
+  /// snapshot of a world with hull contacts or tilted planes.
+  not_compiled,
 };
 
 /// Short, stable name of a status, for messages ("capacity_exceeded").
@@ -59,6 +63,7 @@ constexpr const char* to_string(Status s)
     case Status::invalid_snapshot: return "invalid_snapshot";
     case Status::snapshot_incompatible: return "snapshot_incompatible";
     case Status::shape_mismatch: return "shape_mismatch";
+    case Status::not_compiled: return "not_compiled";
   }
   return "unknown";
 }

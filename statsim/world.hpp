@@ -31,6 +31,7 @@
 #include "statsim/detail/checks.hpp"
 #include "statsim/detail/contact_passes.hpp"
 #include "statsim/detail/events.hpp"
+#include "statsim/detail/feature_checks.hpp"
 #include "statsim/detail/integrate.hpp"
 #include "statsim/detail/shape_setup.hpp"
 #include "statsim/detail/sleep.hpp"
@@ -38,6 +39,7 @@
 #include "statsim/detail/state_hash.hpp"
 #include "statsim/detail/world_data.hpp"
 #include "statsim/detail/world_storage.hpp"
+#include "statsim/features.hpp"
 #include "statsim/signature_scale.hpp"
 #include "statsim/world_def.hpp"
 
@@ -63,12 +65,15 @@ class WorldCore {
 
   /// Replaces the world's parameters. Rejected with `invalid_parameter` (or `non_finite`) if any
   /// is out of range, or if it asks for `BroadPhase::grid` in a world that keeps storage for
-  /// sweep-and-prune only; the world then keeps the parameters it had.
+  /// sweep-and-prune only; with `not_compiled` if it asks for hull contacts in a world without
+  /// `Features::hull_contacts`, or for a gravity that tilts a plane of a world without
+  /// `Features::slopes`; the world then keeps the parameters it had.
   Status configure(const WorldDef<D>& def)
   {
     Status s = detail::check_world_def(def);
     // A world without the grid's storage (`World`'s `Storage` parameter) cannot run it.
     if (s == Status::ok && def.broad_phase == BroadPhase::grid && !w_.grid_storage) s = Status::invalid_parameter;
+    if (s == Status::ok) s = detail::check_features(w_, def);
     if (s == Status::ok) {
       w_.def = def;
       w_.sweep_current = false;  // the sweep axis may have changed
@@ -108,6 +113,7 @@ class WorldCore {
   /// poses: add shapes while setting up, not during steps.
   Added<ShapeId> add_shape(const SignatureView<D>& sig)
   {
+    if (detail::check_statistical(w_) != Status::ok) return {Status::not_compiled, ShapeId{}};
     const Status s = detail::check_signature(sig);
     if (s != Status::ok) return {s, ShapeId{}};
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, ShapeId{}};
@@ -128,7 +134,9 @@ class WorldCore {
   }
 
   /// Adds a static plane with the given normal (any length > 0; it is normalised) through the
-  /// point normal_unit * offset. Fails with `capacity_exceeded` when the plane pool is full.
+  /// point normal_unit * offset. Fails with `capacity_exceeded` when the plane pool is full, and
+  /// with `not_compiled` for a tilted plane (`detail::is_tilted_plane`) in a world without
+  /// `Features::slopes`.
   Added<PlaneId> add_plane(const Vec& normal, Scalar offset)
   {
     if (!detail::finite(normal) || !detail::finite(offset)) return {Status::invalid_plane, 0};
@@ -136,6 +144,9 @@ class WorldCore {
     const Scalar len = normal.norm();
     if (!(len > Scalar(1e-12)) || !detail::finite(len)) return {Status::invalid_plane, 0};
     if (w_.plane_count == w_.max_planes) return {Status::capacity_exceeded, 0};
+    Scalar gn;
+    if (!includes(w_.features, Features::slopes) && detail::is_tilted_plane(w_.def.gravity, Vec(normal / len), gn))
+      return {Status::not_compiled, 0};
     w_.planes[w_.plane_count] = Plane<D>{normal / len, offset};
     ++w_.plane_count;
     w_.tilted_planes = detail::any_tilted_plane(w_);
@@ -194,55 +205,11 @@ class WorldCore {
   /// Advances the world by `dt` seconds (typical 1/60). Rejected with `invalid_time_step` (not
   /// `out_of_range`), changing nothing, if dt is not finite and positive or above `limits::time_step`.
   /// Overflow of the pair buffer is reported in the result, never silent.
-  StepResult step(Scalar dt)
-  {
-    StepResult result;
-    if (!detail::finite(dt) || !(dt > 0) || dt > limits::time_step) {
-      result.status = Status::invalid_time_step;
-      return result;
-    }
-    detail::StepContext ctx;
-    ctx.dt = dt;
-    ctx.tilted_planes = w_.tilted_planes;
-    const auto id = [this](std::uint32_t slot) { return id_of(slot); };
-    impacts_.count = 0;
-    impacts_.found = 0;
-    if (w_.tilted_planes)
-      for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) w_.rolled[k] = 0;
-    result.bodies_integrated = detail::integrate(
-        w_, dt, [&](std::uint32_t i) { return w_.tilted_planes && detail::roll_on_slopes(w_, i, dt, impacts_, id); });
-    detail::update_radii(w_);
-    // Before the broad phase, which replaces last step's pairs (it does not read the flags).
-    detail::forget_contacts(w_);
-    detail::find_pairs(w_, result);
-    detail::record_impacts(w_, impacts_, id);
-    result.impacts_found = impacts_.found;
-    if (impacts_.found > impacts_.count) {
-      result.impacts_dropped = impacts_.found - impacts_.count;
-      result.overflow |= overflow_impacts;
-    }
-    result.contacts += detail::impact_pass(w_, ctx);
-    // A support pass that changed no velocity and moved nothing would be repeated exactly by
-    // the next one: stop there (a resting pile needs one pass, not `support_iterations`; the
-    // result is bit for bit the same).
-    for (int i = 0; i < w_.def.support_iterations; ++i)
-      if (detail::support_pass(w_, ctx) == 0) break;
-    if (w_.def.shock_propagation) {
-      // A position pass after a pass that moved nothing would find every contact as that one
-      // did: skip it (in a resting pile, all of them).
-      std::uint32_t moves = detail::shock_pass(w_, ctx);
-      for (int i = 0; i < w_.def.position_iterations && moves > 0; ++i) moves = detail::position_pass(w_, ctx);
-    }
-    detail::update_motion_states(w_, dt, ctx.tilted_planes);
-    detail::measure_drift(w_);
-    w_.touching_pairs = ctx.touching;
-    result.energy_clamps = ctx.energy_clamps;
-    result.statistical_responses = ctx.statistical_responses;
-    w_.energy_clamps += ctx.energy_clamps;
-    w_.statistical_responses += ctx.statistical_responses;
-    ++w_.step_count;
-    return result;
-  }
+  StepResult step(Scalar dt) { return step_(*this, dt); }
+
+  /// What the world's step is compiled with (`World`'s `Features`).
+  Features features() const { return w_.features; }
+
 
   /// Slots in use, removed bodies' included: ids of live bodies have an index below it (`id_of`).
   std::uint32_t body_count() const { return w_.body_count; }
@@ -346,8 +313,79 @@ class WorldCore {
     bool grid_storage;  ///< `broad_phase` holds the grid too
     detail::PairHull<D>* pair_hulls;  ///< `max_pair_hulls` of them (`STATSIM_HULL_CACHE`)
     std::uint32_t max_pair_hulls;
+    Features features;  ///< what `step` is compiled with
+    StepResult (*step)(WorldCore&, Scalar);  ///< `step_as<FS>` for those features
   };
 
+  /// The step of a world compiled with the parts `FS` (`detail::FeatureSet`); `World` hands
+  /// the core the one its features name, so no other is compiled.
+  template <class FS>
+  static StepResult step_as(WorldCore& core, Scalar dt)
+  {
+    return core.template step_with<FS>(dt);
+  }
+
+ private:
+  template <class FS>
+  StepResult step_with(Scalar dt)
+  {
+    StepResult result;
+    if (!detail::finite(dt) || !(dt > 0) || dt > limits::time_step) {
+      result.status = Status::invalid_time_step;
+      return result;
+    }
+    detail::StepContext<FS> ctx;
+    ctx.dt = dt;
+    ctx.tilted_planes = w_.tilted_planes;
+    const auto id = [this](std::uint32_t slot) { return id_of(slot); };
+    impacts_.count = 0;
+    impacts_.found = 0;
+    if constexpr (FS::slopes) {
+      if (w_.tilted_planes)
+        for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) w_.rolled[k] = 0;
+    }
+    result.bodies_integrated = detail::integrate<FS>(w_, dt, [&](std::uint32_t i) {
+      if constexpr (FS::slopes) {
+        return w_.tilted_planes && detail::roll_on_slopes<FS>(w_, i, dt, impacts_, id);
+      } else {
+        (void)i;
+        return false;
+      }
+    });
+    detail::update_radii<FS>(w_);
+    // Before the broad phase, which replaces last step's pairs (it does not read the flags).
+    detail::forget_contacts(w_);
+    detail::find_pairs<FS>(w_, result);
+    detail::record_impacts<FS>(w_, impacts_, id);
+    result.impacts_found = impacts_.found;
+    if (impacts_.found > impacts_.count) {
+      result.impacts_dropped = impacts_.found - impacts_.count;
+      result.overflow |= overflow_impacts;
+    }
+    result.contacts += detail::impact_pass(w_, ctx);
+    // A support pass that changed no velocity and moved nothing would be repeated exactly by
+    // the next one: stop there (a resting pile needs one pass, not `support_iterations`; the
+    // result is bit for bit the same).
+    for (int i = 0; i < w_.def.support_iterations; ++i)
+      if (detail::support_pass(w_, ctx) == 0) break;
+    if (w_.def.shock_propagation) {
+      // A position pass after a pass that moved nothing would find every contact as that one
+      // did: skip it (in a resting pile, all of them).
+      std::uint32_t moves = detail::shock_pass(w_, ctx);
+      for (int i = 0; i < w_.def.position_iterations && moves > 0; ++i) moves = detail::position_pass(w_, ctx);
+    }
+    detail::update_motion_states<FS>(w_, dt);
+    if constexpr (FS::queries) detail::measure_drift(w_);
+    w_.touching_pairs = ctx.touching;
+    result.energy_clamps = ctx.energy_clamps;
+    result.statistical_responses = ctx.statistical_responses;
+    w_.energy_clamps += ctx.energy_clamps;
+    w_.statistical_responses += ctx.statistical_responses;
+    ++w_.step_count;
+    return result;
+  }
+
+ protected:
   WorldCore(const Storage& s, const WorldDef<D>& def)
       : w_{s.bodies,
            reinterpret_cast<SweepEntry*>(s.broad_phase + detail::BroadPhaseLayout<D>::order(s.max_bodies)),
@@ -368,8 +406,10 @@ class WorldCore {
            s.max_pairs,
            s.max_planes,
            s.max_shapes},
-        impacts_{s.impacts, s.max_impacts}
+        impacts_{s.impacts, s.max_impacts},
+        step_(s.step)
   {
+    w_.features = s.features;
     w_.slots.generation = s.generations;
     w_.slots.free = s.free_slots;
     w_.grid_storage = s.grid_storage;
@@ -384,6 +424,7 @@ class WorldCore {
   friend struct detail::SnapshotAccess;
   detail::WorldData<D> w_;
   detail::ImpactLog<D> impacts_;
+  StepResult (*step_)(WorldCore&, Scalar);
   Status construction_status_ = Status::ok;
   std::uint16_t tag_ = detail::next_world_tag();
 };
@@ -395,9 +436,13 @@ class WorldCore {
 /// static storage, not on the stack (10,000 bodies take about 2 MB with the default pair
 /// buffer). `Phases`: the broad phases the world keeps storage for, `automatic` (both) or
 /// `sweep_and_prune` (its entries only, for small worlds short of memory: `automatic` then
-/// always sweeps, and `WorldDef::broad_phase = grid` is refused).
+/// always sweeps, and `WorldDef::broad_phase = grid` is refused; the grid's code is not
+/// compiled). `F`: the features its scene uses (statsim/features.hpp); the step of a world
+/// without a feature is compiled without its code, and calls that need it are refused with
+/// `Status::not_compiled`. Impact events are compiled only with `MaxImpacts` above 0.
 template <int D, std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic>
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic,
+          Features F = Features::all>
 class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>,
               public WorldCore<D> {
   using StorageBase = detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>;
@@ -412,6 +457,8 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                 "a body holds its shape's index in shape_index_bits bits; plane ids are 16-bit");
   static_assert(MaxBodies <= 1u << body_index_bits, "body ids hold the slot in body_index_bits bits");
   static_assert(Phases != BroadPhase::grid, "the grid's storage holds sweep-and-prune's too: use automatic");
+  static_assert(includes(Features::all, F), "F: a combination of the bits of statsim::Features");
+  using FeatureSet = detail::FeatureSet<F, Phases == BroadPhase::automatic, (MaxImpacts > 0)>;
 
   /// A world with the given parameters; if they are invalid it uses the defaults and
   /// `construction_status()` says why.
@@ -424,7 +471,8 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                          StorageBase::flagged_store.data(), StorageBase::rolled_store.data(), MaxBodies, MaxPairs,
                          MaxPlanes, MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
                          StorageBase::generation_store.data(), StorageBase::free_store.data(), StorageBase::grid,
-                         StorageBase::pair_hull_store.data(), std::uint32_t(StorageBase::pair_hull_store.size())},
+                         StorageBase::pair_hull_store.data(), std::uint32_t(StorageBase::pair_hull_store.size()), F,
+                         &WorldCore<D>::template step_as<FeatureSet>},
                      def)
   {
   }
@@ -435,11 +483,13 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
 /// position, a quaternion orientation and angular velocity vectors. Up is +z. See `World` for the
 /// capacities.
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic>
-using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic,
+          Features F = Features::all>
+using World2 = World<2, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases, F>;
 template <std::uint32_t MaxBodies, std::uint32_t MaxPlanes = 8, std::uint32_t MaxPairs = 6 * MaxBodies,
-          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic>
-using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases>;
+          std::uint32_t MaxShapes = 8, std::uint32_t MaxImpacts = 0, BroadPhase Phases = BroadPhase::automatic,
+          Features F = Features::all>
+using World3 = World<3, MaxBodies, MaxPlanes, MaxPairs, MaxShapes, MaxImpacts, Phases, F>;
 using BodyDef2 = BodyDef<2>;
 using BodyDef3 = BodyDef<3>;
 using WorldDef2 = WorldDef<2>;

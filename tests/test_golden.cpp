@@ -1,7 +1,8 @@
 // Golden hashes: the final state of a fixed scene, bit for bit. A change to the runtime that
 // changes results (on purpose or not) fails here; update the constant in the same commit and
 // say why in its message. The same values hold for Release and for the Debug sanitizer build
-// (the runtime's arithmetic does not depend on the optimisation level).
+// (the runtime's arithmetic does not depend on the optimisation level). Each scene also runs in
+// a world of the smallest feature set that covers it (statsim/features.hpp), to the same hash.
 #include <doctest/doctest.h>
 
 #include "scenes/synthetic_signatures.hpp"
@@ -97,6 +98,8 @@ TEST_CASE("golden hash of a fixed 3D scene")
   const std::uint64_t h = run_scene<3>(*w, statsim::testing::cube_synthetic);
   std::printf("golden 3D: 0x%016llx\n", static_cast<unsigned long long>(h));
   CHECK(h == 0xc85437e3ea1d3791ull);
+  auto small = std::make_unique<World3<150, 8, 900, 8, 0, BroadPhase::sweep_and_prune, Features::paper>>();
+  CHECK(run_scene<3>(*small, statsim::testing::cube_synthetic) == 0xc85437e3ea1d3791ull);
 }
 
 TEST_CASE("golden hash of a fixed 2D scene")
@@ -105,6 +108,8 @@ TEST_CASE("golden hash of a fixed 2D scene")
   const std::uint64_t h = run_scene<2>(*w, statsim::testing::square2d_synthetic);
   std::printf("golden 2D: 0x%016llx\n", static_cast<unsigned long long>(h));
   CHECK(h == 0x4a599b7fe8cacb18ull);
+  auto small = std::make_unique<World2<150, 8, 900, 8, 0, BroadPhase::sweep_and_prune, Features::paper>>();
+  CHECK(run_scene<2>(*small, statsim::testing::square2d_synthetic) == 0x4a599b7fe8cacb18ull);
 }
 
 TEST_CASE("golden hashes of heaps of one shape on the grid (3D and 2D)")
@@ -115,12 +120,16 @@ TEST_CASE("golden hashes of heaps of one shape on the grid (3D and 2D)")
   const std::uint64_t h3 = run_grid_heap<3>(*w3, statsim::testing::cube_synthetic);
   std::printf("golden grid 3D: 0x%016llx\n", static_cast<unsigned long long>(h3));
   CHECK(h3 == 0xa93b5a7782151533ull);
+  auto small3 = std::make_unique<World<3, 600, 4, 600 * 16, 1, 0, BroadPhase::automatic, Features::paper>>(d3);
+  CHECK(run_grid_heap<3>(*small3, statsim::testing::cube_synthetic) == 0xa93b5a7782151533ull);
   WorldDef2 d2;
   d2.broad_phase = BroadPhase::grid;
   auto w2 = std::make_unique<World<2, 600, 4, 600 * 16, 1>>(d2);
   const std::uint64_t h2 = run_grid_heap<2>(*w2, statsim::testing::square2d_synthetic);
   std::printf("golden grid 2D: 0x%016llx\n", static_cast<unsigned long long>(h2));
   CHECK(h2 == 0x2dcb430c025696c8ull);
+  auto small2 = std::make_unique<World<2, 600, 4, 600 * 16, 1, 0, BroadPhase::automatic, Features::paper>>(d2);
+  CHECK(run_grid_heap<2>(*small2, statsim::testing::square2d_synthetic) == 0x2dcb430c025696c8ull);
 }
 
 namespace {
@@ -163,6 +172,8 @@ TEST_CASE("golden hashes of piles of committed shapes with hull contacts (3D and
   const std::uint64_t h3 = run_hull_pile<3>(*w3, s3);
   std::printf("golden hulls 3D: 0x%016llx\n", static_cast<unsigned long long>(h3));
   CHECK(h3 == 0x65db9a2d2ccba5cbull);
+  auto small3 = std::make_unique<World<3, 216, 8, 216 * 24, 8, 0, BroadPhase::sweep_and_prune, Features::piles>>(d3);
+  CHECK(run_hull_pile<3>(*small3, s3) == 0x65db9a2d2ccba5cbull);
   WorldDef2 d2;
   d2.body_contacts = BodyContacts::hulls;
   auto w2 = std::make_unique<World<2, 96, 8, 96 * 16>>(d2);
@@ -170,4 +181,6 @@ TEST_CASE("golden hashes of piles of committed shapes with hull contacts (3D and
   const std::uint64_t h2 = run_hull_pile<2>(*w2, s2);
   std::printf("golden hulls 2D: 0x%016llx\n", static_cast<unsigned long long>(h2));
   CHECK(h2 == 0x619bf28f03256c60ull);
+  auto small2 = std::make_unique<World<2, 96, 8, 96 * 16, 8, 0, BroadPhase::sweep_and_prune, Features::piles>>(d2);
+  CHECK(run_hull_pile<2>(*small2, s2) == 0x619bf28f03256c60ull);
 }

@@ -11,6 +11,10 @@
 // FIRMWARE_SHAPE (0 box, 1 L-shape, 2 bunny), FIRMWARE_I16 (1: response tables as 16-bit
 // integers, quantised at compile time by `statsim::quantize16`, the rule of `statsim gather --precision i16`).
 // FIRMWARE_SNAPSHOT (1; 0 for the footprint variants): the snapshot round trip below.
+// FIRMWARE_FEATURES (0: `Features::all`, the default; 1: `Features::paper`, the smallest set that
+// covers these scenes): what the worlds' steps are compiled with (statsim/features.hpp); the
+// hashes are the same either way. FIRMWARE_ONLY3 (0; 1 needs FIRMWARE_SNAPSHOT=0): the 3D world
+// alone, as a program that steps one scene of one shape would be.
 // FIRMWARE_TRACE (defined): also print the hash after every step. STATSIM_FIRMWARE is defined by
 // the Cortex-M build, STATSIM_WEB by the WebAssembly build.
 //
@@ -48,6 +52,15 @@
 #ifndef FIRMWARE_SNAPSHOT
 #define FIRMWARE_SNAPSHOT 1
 #endif
+#ifndef FIRMWARE_FEATURES
+#define FIRMWARE_FEATURES 0
+#endif
+#ifndef FIRMWARE_ONLY3
+#define FIRMWARE_ONLY3 0
+#endif
+#if FIRMWARE_ONLY3 && FIRMWARE_SNAPSHOT
+#error "FIRMWARE_ONLY3 needs FIRMWARE_SNAPSHOT=0"
+#endif
 
 #if FIRMWARE_SHAPE == 0
 #include <tables/box.hpp>
@@ -60,6 +73,13 @@
 #define FIRMWARE_TABLE statsim::tables::bunny
 #else
 #error "FIRMWARE_SHAPE must be 0 (box), 1 (L-shape) or 2 (bunny)"
+#endif
+#if FIRMWARE_FEATURES == 0
+#define FIRMWARE_FEATURE_SET statsim::Features::all
+#elif FIRMWARE_FEATURES == 1
+#define FIRMWARE_FEATURE_SET statsim::Features::paper
+#else
+#error "FIRMWARE_FEATURES must be 0 (all) or 1 (paper)"
 #endif
 
 #include <cstdint>
@@ -141,12 +161,21 @@ class Line {
   }
   Line& dec(std::uint64_t v)
   {
+    // Long division by 10 over 16-bit pieces, in 32-bit arithmetic: a 64-bit division would link
+    // libgcc's __udivmoddi4, as much code as a phase of the step.
+    std::uint32_t piece[4] = {std::uint32_t(v >> 48), std::uint32_t(v >> 32) & 0xffffu, std::uint32_t(v >> 16) & 0xffffu,
+                              std::uint32_t(v) & 0xffffu};
     char digits[20];
     int k = 0;
     do {
-      digits[k++] = char('0' + v % 10);
-      v /= 10;
-    } while (v);
+      std::uint32_t rest = 0;
+      for (std::uint32_t& p : piece) {
+        const std::uint32_t x = rest << 16 | p;
+        p = x / 10;
+        rest = x % 10;
+      }
+      digits[k++] = char('0' + rest);
+    } while (piece[0] | piece[1] | piece[2] | piece[3]);
     while (k > 0 && n_ + 1 < sizeof buf_) buf_[n_++] = digits[--k];
     return *this;
   }
@@ -179,9 +208,12 @@ void on_assert(const char* expression, const char* file, int line)
 // Up to `WorldDef::grid_above_bodies` (2,048 by default) bodies a world sweeps, so these keep
 // storage for sweep-and-prune only.
 constexpr statsim::BroadPhase sweep_only = statsim::BroadPhase::sweep_and_prune;
-statsim::World3<bodies, 8, pairs3, 2, 0, sweep_only> world3;
-statsim::World2<bodies, 8, pairs2, 2, 0, sweep_only> world2;
-statsim::World3<model_bodies, 1, 4 * model_bodies, 2, 0, sweep_only> world_models;
+constexpr statsim::Features features = FIRMWARE_FEATURE_SET;
+statsim::World3<bodies, 8, pairs3, 2, 0, sweep_only, features> world3;
+#if !FIRMWARE_ONLY3
+statsim::World2<bodies, 8, pairs2, 2, 0, sweep_only, features> world2;
+statsim::World3<model_bodies, 1, 4 * model_bodies, 2, 0, sweep_only, features> world_models;
+#endif
 
 #if FIRMWARE_SNAPSHOT
 // Snapshot buffers, sized for any snapshot of these worlds.
@@ -234,6 +266,7 @@ bool build_world3()
   return true;
 }
 
+#if !FIRMWARE_ONLY3
 bool build_world2()
 {
   const auto shape = world2.add_shape(table2.view());
@@ -281,6 +314,7 @@ bool build_world_models()
   }
   return true;
 }
+#endif  // !FIRMWARE_ONLY3
 
 /// Steps a world and prints its line; returns false if a step failed or dropped pairs.
 template <class World>
@@ -402,7 +436,11 @@ int main()
 #endif
 {
   statsim::set_assert_handler(&on_assert);
+#if FIRMWARE_ONLY3
+  if (!build_world3()) {
+#else
   if (!build_world3() || !build_world2() || !build_world_models()) {
+#endif
     Line().text("firmware: could not build the worlds").emit();
     return 1;
   }
@@ -425,6 +463,9 @@ int main()
   const bool ok_models = run(world_models, "models", "cube_correlated_and_empirical");
   const bool ok_snapshots = continue_snapshot(world3, "snap3", snapshot3, snapshot3_size, true) &&
                             continue_snapshot(world2, "snap2", snapshot2, snapshot2_size, true);
+#elif FIRMWARE_ONLY3
+  const bool ok3 = run(world3, "world3", table3.name);
+  const bool ok2 = true, ok_models = true, ok_snapshots = true;
 #else
   const bool ok3 = run(world3, "world3", table3.name);
   const bool ok2 = run(world2, "world2", table2.name);

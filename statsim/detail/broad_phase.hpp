@@ -31,7 +31,7 @@ inline Pair make_pair(std::uint32_t a, std::uint32_t b)
 /// sweep are apart, and that test needs no radius of the pair when every shape has the same
 /// bounding radius (`common_reach`: twice `WorldData::common_bound`, or 0). `bounding`: the pair
 /// radii are the bounding radii (hull contacts, every shape with a hull).
-template <int D>
+template <class FS, int D>
 void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_reach, bool bounding,
                std::uint32_t& found)
 {
@@ -41,7 +41,7 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_
                                         : w.shapes[ba.shape].bounding_radius + w.shapes[bb.shape].bounding_radius;
   const Scalar d2 = (bb.position - ba.position).squaredNorm();
   if (d2 > bound * bound) return;
-  const Scalar reach = bounding ? bound : pair_radius(w, ba) + pair_radius(w, bb);
+  const Scalar reach = bounding ? bound : pair_radius<FS>(w, ba) + pair_radius<FS>(w, bb);
   if (d2 > reach * reach) return;
   if (found < w.max_pairs) w.pairs[found] = a < b ? make_pair(a, b) : make_pair(b, a);
   ++found;
@@ -262,7 +262,7 @@ bool search_grid_parts(const GridSearch<D>& s, std::uint32_t& found, std::uint32
 /// Pairs from the grid of cells one widest reach (twice the largest `pair_radius`) wide: each
 /// awake body looks at the bodies in the 3^D cells around its own. Returns how many were found
 /// (also those that did not fit the buffer).
-template <int D>
+template <class FS, int D>
 std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
 {
   SpatialHash<D>& grid = w.grid;
@@ -270,7 +270,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
   // afresh; it is never above the widest bounding diameter.
   Scalar widest = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
-    const Scalar r = pair_radius(w, w.bodies[i]);
+    const Scalar r = pair_radius<FS>(w, w.bodies[i]);
     widest = r > widest ? r : widest;
   }
   if (!(widest > 0)) widest = Scalar(0.5) * w.widest;
@@ -285,7 +285,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
   const auto asleep = [&w](std::uint32_t i) { return !bit_set(w.awake, i); };
   const auto item = [&w, &asleep](std::uint32_t i) {
     const Body<D>& b = w.bodies[i];
-    return GridItem<D>{b.position, pair_radius(w, b), asleep(i) ? i + asleep_key : i};
+    return GridItem<D>{b.position, pair_radius<FS>(w, b), asleep(i) ? i + asleep_key : i};
   };
   grid.build(w.body_count, cell, item, asleep);
   made_records(w, true);
@@ -303,7 +303,7 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
 
 /// Pairs from sweep-and-prune along `WorldDef::sweep_axis`. The entries keep last step's order,
 /// so the insertion sort has little to do. Returns how many pairs were found.
-template <int D>
+template <class FS, int D>
 std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
 {
   // With no body awake there is no pair; if the entries were sorted on the bodies' present
@@ -333,18 +333,18 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   // loop costs it more than the count is worth.
   std::uint32_t found = 0;
   // With hull contacts every pair radius is the bounding radius where every shape has a hull.
-  bool bounding = w.def.body_contacts == BodyContacts::hulls;
+  bool bounding = FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls;
   for (std::uint32_t k = 0; k < w.shape_count; ++k) bounding = bounding && has_hull(w.shapes[k]);
   const Scalar common_reach = common + common;
   sweep_active(w.entries, w.body_count, widest,
-               [&](std::uint32_t a, std::uint32_t b) { candidate(w, a, b, common_reach, bounding, found); });
+               [&](std::uint32_t a, std::uint32_t b) { candidate<FS>(w, a, b, common_reach, bounding, found); });
   return found;
 }
 
 /// Hands the broad phase's block from sweep-and-prune to the grid or back, keeping the sweep order:
 /// entry k (12 bytes at 12 k) to index k (4 bytes at 4 k) in increasing k, and back in decreasing
 /// k, so that nothing is overwritten before it is read.
-template <int D>
+template <class FS, int D>
 void switch_broad_phase(WorldData<D>& w)
 {
   if (!w.grid_layout) {
@@ -364,21 +364,24 @@ void switch_broad_phase(WorldData<D>& w)
 
 /// Fills the pair buffer with this step's candidate pairs, up to its capacity; the result tells
 /// how many were found and how many did not fit.
-template <int D>
+template <class FS, int D>
 void find_pairs(WorldData<D>& w, StepResult& result)
 {
-  const bool grid = w.grid_storage && (w.def.broad_phase == BroadPhase::grid ||
-                                       (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies));
   std::uint32_t found = 0;
-  if (grid != w.grid_layout) switch_broad_phase(w);
-  if (grid) {
-    // The grid keeps nothing from step to step but its sizes; bodies move under the entries.
-    w.sweep_current = false;
-    // Two sleepers are never a pair.
-    if (w.awake_count > 0) found = find_pairs_grid(w, result);
-  } else {
-    found = find_pairs_sweep(w, result);
+  bool grid = false;
+  // A world without the grid's storage (`World`'s `Phases`) never holds the grid's layout.
+  if constexpr (FS::grid) {
+    grid = w.grid_storage && (w.def.broad_phase == BroadPhase::grid ||
+                              (w.def.broad_phase == BroadPhase::automatic && w.body_count > w.def.grid_above_bodies));
+    if (grid != w.grid_layout) switch_broad_phase<FS>(w);
+    if (grid) {
+      // The grid keeps nothing from step to step but its sizes; bodies move under the entries.
+      w.sweep_current = false;
+      // Two sleepers are never a pair.
+      if (w.awake_count > 0) found = find_pairs_grid<FS>(w, result);
+    }
   }
+  if (!grid) found = find_pairs_sweep<FS>(w, result);
   result.pairs_found = found;
   if (found > w.max_pairs) {
     result.pairs_dropped = found - w.max_pairs;

@@ -54,8 +54,8 @@ constexpr Scalar contact_slop = Scalar(1e-3);
 /// paper), the rest turn for bodies settling on the ground (paper 3.4), else (plain spheres,
 /// and resting contacts of statistical bodies) the particle response against a static plane.
 /// `tilted_plane`: the contact is with a plane that gravity pulls the body along.
-template <int D>
-void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const typename Space<D>::Vec& n,
+template <int D, class FS>
+void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, const typename Space<D>::Vec& n,
                    const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false,
                    Scalar gap = 0)
 {
@@ -70,12 +70,12 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
   // from the strikes of its faces one after the other, each set by the last, which independent
   // samples of the tables' single-impact responses do not reproduce. A body that rolled through
   // the step in substeps (`roll_on_slopes`) has had its slope contacts there.
-  if (tilted_plane && rolls_on(w, b, n)) {
+  if (tilted_plane && rolls_on<FS>(w, b, n)) {
     if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)))
       slope_hull_response(shape, b, n, def.gravity, gap, ctx.dt, threshold);
     return;
   }
-  if (shape.statistical && tilted_plane && resting && !(ground_contact && b.rest_pose != no_rest_pose)) {
+  if (FS::slopes && shape.statistical && tilted_plane && resting && !(ground_contact && b.rest_pose != no_rest_pose)) {
     // Rolling resistance taken off the velocity of a point without lever arm brakes its sliding
     // as extra friction: a slide down the plane at g (sin a - (mu + c) cos a) instead of
     // g (sin a - mu cos a), and sliding only from tan a > mu + c. On a tilted plane it slows the
@@ -127,8 +127,8 @@ void respond_alone(const WorldData<D>& w, StepContext& ctx, Body<D>& b, const ty
 /// `PairResponse::momentum` the two changes of relative velocity are averaged into one impulse
 /// that each body takes in proportion to its inverse mass, so momentum is conserved and the
 /// pair's kinetic energy in its centre-of-mass frame cannot grow; spins stay as sampled.
-template <int D>
-void respond_pair(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D>& b, const typename Space<D>::Vec& n,
+template <int D, class FS>
+void respond_pair(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& a, Body<D>& b, const typename Space<D>::Vec& n,
                   Scalar ima, Scalar imb)
 {
   using Vec = typename Space<D>::Vec;
@@ -180,8 +180,8 @@ Scalar inverse_masses(const Body<D>& a, const Body<D>& b, const typename Space<D
 /// `reach`, the separation at which they touch),
 /// times `overlap_correction`, split in proportion to inverse mass (in the bottom-up passes the
 /// lower body's is 0), so a sleeper does not move.
-template <int D>
-void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D>& b, const Contact<D>& c,
+template <int D, class FS>
+void correct_overlap(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& a, Body<D>& b, const Contact<D>& c,
                      Scalar slop, Scalar reach, Scalar ima, Scalar imb, Scalar ims)
 {
   const Scalar depth = (c.depth - slop - w.def.allowed_overlap * reach) * w.def.overlap_correction;
@@ -197,8 +197,8 @@ void correct_overlap(const WorldData<D>& w, StepContext& ctx, Body<D>& a, Body<D
 /// (tilted: gravity pulls the body along the plane); on a tilted plane it then takes the
 /// downhill move back that the response's friction cancelled.
 /// Returns the number of contacts.
-template <int D, class Respond>
-std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Respond&& respond)
+template <int D, class FS, class Respond>
+std::uint32_t plane_contacts(WorldData<D>& w, StepContext<FS>& ctx, bool grown, Respond&& respond)
 {
   using Vec = typename Space<D>::Vec;
   const Vec& g = w.def.gravity;
@@ -212,10 +212,10 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       // (a speculative contact: `slope_hull_response` lets it close the gap in the step and no
       // more): turning about a corner, the hull's support falls away from the plane by about
       // (1 - cos(w dt)) times the support in a step, and the corner would lose the plane.
-      const bool hull = ctx.tilted_planes && rolls_on(w, b, w.planes[p].normal);
+      const bool hull = FS::slopes && ctx.tilted_planes && rolls_on<FS>(w, b, w.planes[p].normal);
       const Scalar slop = hull ? w.shapes[b.shape].bounding_radius * slope_reach
                                : (grown ? b.radius * contact_slop : Scalar(0));
-      if (!sphere_plane_contact<D>(b.position, plane_radius(w, b, w.planes[p]) + slop, w.planes[p], c)) continue;
+      if (!sphere_plane_contact<D>(b.position, plane_radius<FS>(w, b, w.planes[p]) + slop, w.planes[p], c)) continue;
       if (c.depth > slop) {
         b.position += c.normal * (c.depth - slop);
         ++ctx.moves;
@@ -235,7 +235,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
       // at most g_t dt, times dt. Planes that carry no weight (n.g >= 0, walls) and level ones
       // (g_t = 0 exactly) are left alone.
       Scalar gn;
-      if (!ctx.tilted_planes || !is_tilted_plane(g, c.normal, gn)) {
+      if (!FS::slopes || !ctx.tilted_planes || !is_tilted_plane(g, c.normal, gn)) {
         respond(b, c, ground, false);
         continue;
       }
@@ -260,7 +260,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext& ctx, bool grown, Resp
 /// `compact`, touching pairs move to the front of the buffer, in their order. With `keep`, each
 /// pair's face contact is kept for the later passes (`WorldData::pair_hulls`, at the pair's new
 /// place), which read it. Returns the number of touching pairs.
-template <int D, class Resolve>
+template <class FS, int D, class Resolve>
 std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bool compact, bool keep,
                             Resolve&& resolve, bool fresh = true)
 {
@@ -274,7 +274,7 @@ std::uint32_t pair_contacts(WorldData<D>& w, std::uint32_t count, bool grown, bo
     // that place to the next.
     const std::uint32_t slot = compact ? touching : k;
     PairHull<D>* kept = STATSIM_HULL_CACHE && slot < w.max_pair_hulls ? &w.pair_hulls[slot] : nullptr;
-    if (!body_contact(w, a, b, w.pairs[k], fresh && !grown, grown ? contact_slop : Scalar(0), c, reach, slop, kept, keep))
+    if (!body_contact<FS>(w, a, b, w.pairs[k], fresh && !grown, grown ? contact_slop : Scalar(0), c, reach, slop, kept, keep))
       continue;
     if (compact) std::swap(w.pairs[touching], w.pairs[k]);
     ++touching;
@@ -305,11 +305,11 @@ void forget_contacts(WorldData<D>& w)
 }
 
 /// The plane contacts of a support pass (and of the shock pass): inelastic particle responses.
-template <int D>
-void support_planes(WorldData<D>& w, StepContext& ctx)
+template <int D, class FS>
+void support_planes(WorldData<D>& w, StepContext<FS>& ctx)
 {
   plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool tilted) {
-    if (tilted && rolls_on(w, b, c.normal)) {
+    if (tilted && rolls_on<FS>(w, b, c.normal)) {
       if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)) &&
           slope_hull_response(w.shapes[b.shape], b, c.normal, w.def.gravity, -c.depth, ctx.dt, no_bounce))
         ++ctx.changes;
@@ -324,20 +324,20 @@ void support_planes(WorldData<D>& w, StepContext& ctx)
 /// The impact pass: planes, then pairs, each with the bodies' own response; awake bodies that hit
 /// a sleeper faster than `wake_speed` wake it. Leaves the touching pairs at the front of the pair
 /// buffer and their number in `ctx.touching`. Returns the number of contacts.
-template <int D>
-std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
+template <int D, class FS>
+std::uint32_t impact_pass(WorldData<D>& w, StepContext<FS>& ctx)
 {
   using Vec = typename Space<D>::Vec;
   const WorldDef<D>& def = w.def;
   const std::uint32_t plane_count = plane_contacts(w, ctx, false, [&](Body<D>& b, const Contact<D>& c, bool ground,
                                                                       bool tilted) {
-    if (w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground, tilted, -c.depth);
+    if (FS::statistical && w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground, tilted, -c.depth);
     else if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
                                         w.shapes[b.shape].material, def.restitution_threshold))
       ++ctx.changes;
   });
-  const bool searched = search_witnesses_first(w);
-  ctx.touching = pair_contacts(w, w.pair_count, false, true, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c,
+  const bool searched = search_witnesses_first<FS>(w);
+  ctx.touching = pair_contacts<FS>(w, w.pair_count, false, true, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c,
                                                                        Scalar slop, Scalar reach) {
     const Vec& n = c.normal;
     const bool a_asleep = a.state == MotionState::asleep;
@@ -346,7 +346,7 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
       // An awake body hitting a sleeper fast enough, or pressed deep into its hull, wakes it;
       // otherwise the sleeper is static.
       const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(n);
-      if (approach > def.wake_speed || wakes_by_overlap(w, a, b, c.depth, reach)) {
+      if (approach > def.wake_speed || wakes_by_overlap<FS>(w, a, b, c.depth, reach)) {
         if (a_asleep) wake(w, a);
         if (b_asleep) wake(w, b);
       }
@@ -354,7 +354,7 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
     Scalar ima, imb;
     const Scalar ims = inverse_masses(a, b, n, false, ima, imb);
     if (ims <= 0) return false;
-    if (w.shapes[a.shape].statistical || w.shapes[b.shape].statistical) respond_pair(w, ctx, a, b, n, ima, imb);
+    if (FS::statistical && (w.shapes[a.shape].statistical || w.shapes[b.shape].statistical)) respond_pair(w, ctx, a, b, n, ima, imb);
     else if (particle_pair(w, a, b, n, ima, imb, def.restitution_threshold)) ++ctx.changes;
     if (!def.shock_propagation) correct_overlap(w, ctx, a, b, c, slop, reach, ima, imb, ims);
     return true;
@@ -365,11 +365,11 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext& ctx)
 /// A support pass over the touching pairs, then the planes: inelastic particle responses, planes
 /// last, since a pair push can drive a body into the ground and the ground has the last word on
 /// position and velocity. Returns the number of impulses and position corrections.
-template <int D>
-std::uint32_t support_pass(WorldData<D>& w, StepContext& ctx)
+template <int D, class FS>
+std::uint32_t support_pass(WorldData<D>& w, StepContext<FS>& ctx)
 {
   ctx.changes = 0;
-  pair_contacts(w, ctx.touching, true, false, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar, Scalar) {
+  pair_contacts<FS>(w, ctx.touching, true, false, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar, Scalar) {
     Scalar ima, imb;
     if (inverse_masses(a, b, c.normal, false, ima, imb) <= 0) return false;
     if (particle_pair(w, a, b, c.normal, ima, imb, no_bounce)) ++ctx.changes;
@@ -399,14 +399,15 @@ void sort_bottom_up(WorldData<D>& w, std::uint32_t count)
 /// The shock pass: the touching pairs from the bottom up, lower bodies frozen, inelastic
 /// responses and the step's overlap correction; then the planes as in a support pass. Returns
 /// the number of position corrections.
-template <int D>
-std::uint32_t shock_pass(WorldData<D>& w, StepContext& ctx)
+template <int D, class FS>
+std::uint32_t shock_pass(WorldData<D>& w, StepContext<FS>& ctx)
 {
   sort_bottom_up(w, ctx.touching);
   ctx.moves = 0;
   typename Space<D>::Vec gravity_unit = Space<D>::Vec::Zero();
   Scalar gravity = 0;
-  const bool tipping = tip_gravity(w, gravity_unit, gravity);
+  bool tipping = false;
+  if constexpr (FS::hull_contacts) tipping = tip_gravity<FS>(w, gravity_unit, gravity);
   bool overhangs = false;
   if (tipping)
     for (std::uint32_t k = 0; k < ctx.touching; ++k) {
@@ -414,10 +415,12 @@ std::uint32_t shock_pass(WorldData<D>& w, StepContext& ctx)
       w.bodies[w.pairs[k].b].supports = 0;
     }
   // The sort moved the pairs away from their kept contacts: the pass keeps them afresh.
-  pair_contacts(w, ctx.touching, true, false, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop,
+  pair_contacts<FS>(w, ctx.touching, true, false, true, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop,
                                                         Scalar reach) {
     // Marked before the correction moves the pair: where the step's passes left it.
-    if (tipping && mark_supports(w, a, b, c.normal, gravity_unit)) overhangs = true;
+    if constexpr (FS::hull_contacts) {
+      if (tipping && mark_supports<FS>(w, a, b, c.normal, gravity_unit)) overhangs = true;
+    }
     Scalar ima, imb;
     const Scalar ims = inverse_masses(a, b, c.normal, true, ima, imb);
     if (ims <= 0) return false;
@@ -426,18 +429,20 @@ std::uint32_t shock_pass(WorldData<D>& w, StepContext& ctx)
     return true;
   });
   support_planes(w, ctx);
-  if (overhangs) tip_unsupported(w, ctx.touching, gravity_unit, gravity, contact_slop);
+  if constexpr (FS::hull_contacts) {
+    if (overhangs) tip_unsupported<FS>(w, ctx.touching, gravity_unit, gravity, contact_slop);
+  }
   return ctx.moves;
 }
 
 /// A position pass: the shock pass's overlap correction alone, in its order and with its frozen
 /// bodies, then bodies moved out of planes; velocities are left as the passes before settled
 /// them. Returns the number of position corrections.
-template <int D>
-std::uint32_t position_pass(WorldData<D>& w, StepContext& ctx)
+template <int D, class FS>
+std::uint32_t position_pass(WorldData<D>& w, StepContext<FS>& ctx)
 {
   ctx.moves = 0;
-  pair_contacts(w, ctx.touching, true, false, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop, Scalar reach) {
+  pair_contacts<FS>(w, ctx.touching, true, false, false, [&](Body<D>& a, Body<D>& b, const Contact<D>& c, Scalar slop, Scalar reach) {
     Scalar ima, imb;
     const Scalar ims = inverse_masses(a, b, c.normal, true, ima, imb);
     if (ims <= 0) return false;

@@ -35,10 +35,13 @@ struct ImpactLog {
 /// (on copies: the pass finds them again itself). The slope contacts of bodies that rolled in
 /// substeps are not the pass's: `roll_on_slopes` recorded their impacts. `id_of(slot)` is the id
 /// of the body in a slot.
-template <int D, class IdOf>
+template <class FS, int D, class IdOf>
 void record_impacts(const WorldData<D>& w, ImpactLog<D>& log, IdOf&& id_of)
 {
   using Vec = typename Space<D>::Vec;
+  if constexpr (!FS::events) {
+    return;
+  }
   if (log.capacity == 0) return;
   const Scalar threshold = w.def.impact_threshold;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
@@ -46,8 +49,8 @@ void record_impacts(const WorldData<D>& w, ImpactLog<D>& log, IdOf&& id_of)
     for (std::uint32_t p = 0; p < w.plane_count; ++p) {
       const Plane<D>& plane = w.planes[p];
       Contact<D> c;
-      if (w.tilted_planes && bit_set(w.rolled, i) && rolls_on(w, b, plane.normal)) continue;
-      if (!sphere_plane_contact<D>(b.position, plane_radius(w, b, plane), plane, c)) continue;
+      if (FS::slopes && w.tilted_planes && bit_set(w.rolled, i) && rolls_on<FS>(w, b, plane.normal)) continue;
+      if (!sphere_plane_contact<D>(b.position, plane_radius<FS>(w, b, plane), plane, c)) continue;
       const Scalar approach = -b.linear_velocity.dot(c.normal);
       if (!(approach > threshold)) continue;
       const Vec foot = b.position - c.normal * (c.normal.dot(b.position) - plane.offset);
@@ -60,7 +63,7 @@ void record_impacts(const WorldData<D>& w, ImpactLog<D>& log, IdOf&& id_of)
     Body<D> b = w.bodies[pair.b];
     Contact<D> c;
     Scalar reach, slop;
-    if (!body_contact(w, a, b, pair, true, Scalar(0), c, reach, slop)) continue;
+    if (!body_contact<FS>(w, a, b, pair, true, Scalar(0), c, reach, slop)) continue;
     const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(c.normal);
     if (!(approach > threshold)) continue;
     const Scalar gap = (b.position - a.position).norm();

@@ -285,21 +285,21 @@ std::uint32_t find_hull_witness(const Shape<D>& sa, const Body<D>& a, const Shap
 
 /// True when two bodies touch at their hulls (`BodyContacts::hulls`, both shapes with a hull, at
 /// least one statistical).
-template <int D>
+template <class FS = AllFeatures, int D>
 bool hull_pair(const WorldData<D>& w, const Body<D>& a, const Body<D>& b)
 {
   const Shape<D>& sa = w.shapes[a.shape];
   const Shape<D>& sb = w.shapes[b.shape];
-  return w.def.body_contacts == BodyContacts::hulls && has_hull(sa) && has_hull(sb) &&
+  return FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && has_hull(sa) && has_hull(sb) &&
          (sa.statistical || sb.statistical);
 }
 
 /// Whether a hull pair overlapping by `depth` of its `reach`, one of the two asleep, wakes the
 /// sleeper (`hull_wake_overlap`).
-template <int D>
+template <class FS = AllFeatures, int D>
 bool wakes_by_overlap(const WorldData<D>& w, const Body<D>& a, const Body<D>& b, Scalar depth, Scalar reach)
 {
-  if (!(depth > hull_wake_overlap * reach) || !hull_pair(w, a, b)) return false;
+  if (!(depth > hull_wake_overlap * reach) || !hull_pair<FS>(w, a, b)) return false;
   const Body<D>& presser = a.state == MotionState::asleep ? b : a;
   return depth > 2 * hull_wake_overlap * reach || presser.slow_time == 0 || squared_norm(presser.angular_velocity) > 0;
 }
@@ -345,16 +345,21 @@ void search_witness(const Shape<D>& sa, const Body<D>& a, const Shape<D>& sb, co
 /// of the reach. Fills the contact and the reach (separation along the normal at which they
 /// touch, m). `kept` (may be null): with `keep`, receives the pair's face contact (reach 0 for
 /// none); without, a face contact kept earlier in the step, used as found (`PairHull`).
-template <int D>
+template <class FS = AllFeatures, int D>
 bool body_contact(const WorldData<D>& w, Body<D>& a, Body<D>& b, Pair& pair, bool fresh, Scalar slop_fraction,
                   Contact<D>& c, Scalar& reach, Scalar& slop, PairHull<D>* kept = nullptr, bool keep = false)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& sa = w.shapes[a.shape];
   const Shape<D>& sb = w.shapes[b.shape];
+  if constexpr (!FS::hull_contacts) {
+    reach = a.radius + b.radius;
+    slop = reach * slop_fraction;
+    return sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c);
+  }
   if (STATSIM_HULL_CACHE && kept && keep) kept->reach = 0;
   const bool known = STATSIM_HULL_CACHE && kept && !keep && kept->reach > 0;
-  if (!known && !hull_pair(w, a, b)) {
+  if (!known && !hull_pair<FS>(w, a, b)) {
     reach = a.radius + b.radius;
     slop = reach * slop_fraction;
     return sphere_sphere_contact<D>(a.position, a.radius + slop, b.position, b.radius, c);

@@ -14,20 +14,20 @@ namespace detail {
 /// moves the body; orientation without trigonometry (`detail::integrate`). `own(i)` may move
 /// body i through the step itself (`roll_on_slopes`) and return true. Returns the number of
 /// bodies integrated.
-template <int D, class Own>
+template <class FS, int D, class Own>
 std::uint32_t integrate(WorldData<D>& w, Scalar dt, Own&& own)
 {
   using Vec = typename Space<D>::Vec;
   const Vec dv = w.def.gravity * dt;
   const Scalar lin_damp = Scalar(1) / (1 + dt * w.def.linear_damping);
   const Scalar ang_damp = Scalar(1) / (1 + dt * w.def.angular_damping);
-  const bool hulls = w.def.body_contacts == BodyContacts::hulls;
+  const bool hulls = FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls;
   std::uint32_t count = 0;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
     // The sleep test may measure from where the body's slow time began (`sleeps_from_anchor`):
     // the centre is kept there while the clock runs.
-    if (b.slow_time == 0 || !hulls || !sleeps_from_anchor(w, b)) b.step_start = b.position;
+    if (b.slow_time == 0 || !hulls || !sleeps_from_anchor<FS>(w, b)) b.step_start = b.position;
     ++count;
     if (own(i)) return;
     b.linear_velocity = (b.linear_velocity + dv) * lin_damp;

@@ -40,10 +40,13 @@ typename Space<D>::Vec ground_normal(const WorldData<D>& w, const Body<D>& b)
 
 /// Collision radius of statistical bodies (paper 3.3.1), blended toward the rest height of a
 /// chosen rest pose (paper 3.4).
-template <int D>
+template <class FS, int D>
 void update_radii(WorldData<D>& w)
 {
   using Vec = typename Space<D>::Vec;
+  if constexpr (!FS::statistical) {
+    return;
+  }
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
     const Shape<D>& shape = w.shapes[b.shape];
@@ -67,7 +70,7 @@ void update_radii(WorldData<D>& w)
     // (On a slope the body keeps its hull's support from the plane instead: `hull_radius`.)
     if (b.on_ground) {
       const Vec n = ground_normal(w, b);
-      if (!slope_hull(w, b, n)) b.position += n * (blended - b.radius);
+      if (!slope_hull<FS>(w, b, n)) b.position += n * (blended - b.radius);
     } else if (b.pile_rest) {
       b.position[Space<D>::up_axis] += blended - b.radius;
     }
@@ -79,10 +82,13 @@ void update_radii(WorldData<D>& w)
 /// pose nearest to its orientation relative to the ground's normal `ground` and blends its
 /// radius toward that pose's height; a body that speeds up again blends back and forgets the
 /// pose; a body briefly off the ground keeps it.
-template <int D>
+template <class FS, int D>
 void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground, bool settling_on_bodies, bool fast,
                       Scalar dt, const typename Space<D>::Vec& ground)
 {
+  if constexpr (!FS::statistical) {
+    return;
+  }
   const Shape<D>& shape = w.shapes[b.shape];
   const WorldDef<D>& def = w.def;
   if (!shape.statistical || !def.rest_conditions || shape.signature.rest.count == 0) return;
@@ -119,9 +125,10 @@ bool in_rest_pose(const WorldData<D>& w, const Body<D>& b, const typename Space<
 /// The last phase of a step: each awake body is moving, settling (touching and slower than
 /// `settle_speed`) or, once still for `sleep_time`, asleep; settling bodies follow the resting
 /// conditions.
-template <int D>
-void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
+template <class FS, int D>
+void update_motion_states(WorldData<D>& w, Scalar dt)
 {
+  const bool tilted_planes = FS::slopes && w.tilted_planes;
   using Vec = typename Space<D>::Vec;
   const WorldDef<D>& def = w.def;
   const Scalar settle2 = def.settle_speed * def.settle_speed;
@@ -142,12 +149,12 @@ void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
     // On a slope a pose steeper than its tipping angle is no rest pose (`settle_on_slope`).
     // A body rolling on its hull down a slope (statsim/detail/slope_contact.hpp) takes a pose only once
     // its contacts have all but stopped it there: the faces it rolls over are not poses it rests in.
-    const bool rolling = tilted_planes && settling && b.on_ground && speed2 >= sleep2 && rolls_on(w, b, ground);
+    const bool rolling = tilted_planes && settling && b.on_ground && speed2 >= sleep2 && rolls_on<FS>(w, b, ground);
     const SlopeSettle slope = rolling                                   ? SlopeSettle::tipping
-                              : tilted_planes && settling && b.on_ground ? settle_on_slope(w, b, ground)
+                              : tilted_planes && settling && b.on_ground ? settle_on_slope<FS>(w, b, ground)
                                                                          : SlopeSettle::pose;
     const bool tipping = slope == SlopeSettle::tipping;
-    update_rest_pose(w, b, settling && b.on_ground && slope == SlopeSettle::pose, settling && !b.on_ground,
+    update_rest_pose<FS>(w, b, settling && b.on_ground && slope == SlopeSettle::pose, settling && !b.on_ground,
                      speed2 >= settle2, dt, ground);
     if (!settling) {
       b.state = MotionState::moving;
@@ -167,7 +174,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
     // measured from where its slow time began (`sleeps_from_anchor`; `integrate` keeps it there):
     // it is still while it stays within the distance a body at the sleep speed covers in the
     // sleep time, |x - x_0| < v_sleep t_sleep, as well as while it is slower than the sleep speed.
-    if (sleeps_from_anchor(w, b)) {
+    if (sleeps_from_anchor<FS>(w, b)) {
       const Scalar reach = def.sleep_speed * def.sleep_time;
       if (moved2 < reach * reach) lin2 = 0;
     }
@@ -177,7 +184,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
     const bool posed = !turning || b.rest_pose == no_rest_pose || !b.on_ground || in_rest_pose(w, b, ground);
     // On its hull (`hull_radius`) a body propped by others may stay still out of its pose; it
     // sleeps where it is after three sleep times.
-    const bool wedged = !posed && hull_radius(w, b, ground) > b.radius;
+    const bool wedged = !posed && hull_radius<FS>(w, b, ground) > b.radius;
     const bool still = !tipping && (lin2 > w2 ? lin2 : w2) < sleep2 && (posed || wedged);
     b.slow_time = still ? b.slow_time + dt : 0;
     if (still && b.slow_time >= (posed ? def.sleep_time : 3 * def.sleep_time)) {
@@ -193,7 +200,7 @@ void update_motion_states(WorldData<D>& w, Scalar dt, bool tilted_planes)
         // The centre stood `hull_radius` above the ground (the collision radius, or the hull's
         // support where that is more): it ends at the pose's height above it.
         const SignatureView<D>& sig = w.shapes[b.shape].signature;
-        const Scalar above = hull_radius(w, b, ground);
+        const Scalar above = hull_radius<FS>(w, b, ground);
         b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
         const Scalar h = sig.rest.heights[b.rest_pose];
         b.position += ground * (h - above);

@@ -38,9 +38,12 @@ bool any_tilted_plane(const WorldData<D>& w)
 /// (statsim/detail/slope_contact.hpp): the plane is tilted (`is_tilted_plane`) and the body statistical,
 /// with a support map and principal moments. On level ground and walls bodies keep their
 /// collision spheres.
-template <int D>
+template <class FS = AllFeatures, int D>
 bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
 {
+  if constexpr (!FS::slopes || !FS::statistical) {
+    return false;
+  }
   if (!w.tilted_planes) return false;
   const Shape<D>& s = w.shapes[b.shape];
   if (!s.statistical || !s.signature.contact.present()) return false;
@@ -52,23 +55,26 @@ bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>
 
 /// True when body `b` meets a plane of unit normal `n` (towards the body) with its hull
 /// (`slope_hull`) and has no rest pose chosen: its contacts there are `slope_hull_response`'s.
-template <int D>
+template <class FS = AllFeatures, int D>
 bool rolls_on(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
 {
-  return b.rest_pose == no_rest_pose && slope_hull(w, b, n);
+  return b.rest_pose == no_rest_pose && slope_hull<FS>(w, b, n);
 }
 
 /// The radius a body keeps from a plane of normal `n`: its collision radius, or its hull's
 /// support toward the plane on a slope (`slope_hull`), or, for a settling body with a hull
 /// (`BodyContacts::hulls`), at least its hull's support toward the plane, so that a body resting
 /// out of its rest poses (propped by others) does not sink its hull into the ground or a wall.
-template <int D>
+template <class FS = AllFeatures, int D>
 Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
 {
+  if constexpr (!FS::statistical || (!FS::slopes && !FS::hull_contacts)) {
+    return b.radius;
+  }
   const Shape<D>& s = w.shapes[b.shape];
-  if (slope_hull(w, b, n))
+  if (slope_hull<FS>(w, b, n))
     return support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
-  if (w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling || !s.statistical ||
+  if (!FS::hull_contacts || w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling || !s.statistical ||
       !s.signature.contact.present())
     return b.radius;
   const Scalar hull = support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
@@ -77,15 +83,16 @@ Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
 
 /// `hull_radius` against a plane, where it matters: the support is read only when the plane is
 /// within the body's bounding radius.
-template <int D>
+template <class FS = AllFeatures, int D>
 Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& plane)
 {
   // `hull_radius`'s first tests, before the plane's distance: every body meets every plane in
   // every pass, and most need neither.
-  if (!w.tilted_planes && (w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling))
-    return b.radius;
+  const bool slopes = FS::slopes && w.tilted_planes;
+  const bool hulls = FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && b.state == MotionState::settling;
+  if (!slopes && !hulls) return b.radius;
   if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
-  return hull_radius(w, b, plane.normal);
+  return hull_radius<FS>(w, b, plane.normal);
 }
 
 }  // namespace detail

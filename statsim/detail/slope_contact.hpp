@@ -209,7 +209,7 @@ constexpr Scalar slope_contact_step = Scalar(0.001);
 /// (each substep's, with the approach speed of the centre, as `record_impacts` measures it).
 /// Marks the body in `WorldData::rolled`: the step's contact passes leave its slope contacts
 /// alone. Returns false, changing nothing, for any other body.
-template <int D, class IdOf>
+template <class FS, int D, class IdOf>
 bool roll_on_slopes(WorldData<D>& w, std::uint32_t i, Scalar dt, ImpactLog<D>& log, IdOf&& id_of)
 {
   using Vec = typename Space<D>::Vec;
@@ -222,10 +222,10 @@ bool roll_on_slopes(WorldData<D>& w, std::uint32_t i, Scalar dt, ImpactLog<D>& l
   bool near = false;
   for (std::uint32_t p = 0; p < w.plane_count && b.touching && !near; ++p) {
     const Plane<D>& plane = w.planes[p];
-    if (!rolls_on(w, b, plane.normal)) continue;
+    if (!rolls_on<FS>(w, b, plane.normal)) continue;
     // The hull's support never exceeds the bounding radius: read it only when that can reach.
     const Scalar distance = plane.normal.dot(b.position) - plane.offset;
-    near = distance - shape.bounding_radius < reach && distance - hull_radius(w, b, plane.normal) < reach;
+    near = distance - shape.bounding_radius < reach && distance - hull_radius<FS>(w, b, plane.normal) < reach;
   }
   if (!near) return false;
   const int steps = int(std::ceil(dt / slope_contact_step));  // dt <= limits::time_step
@@ -237,8 +237,8 @@ bool roll_on_slopes(WorldData<D>& w, std::uint32_t i, Scalar dt, ImpactLog<D>& l
     b.angular_velocity = b.angular_velocity * ang_damp;
     for (std::uint32_t p = 0; p < w.plane_count; ++p) {
       const Plane<D>& plane = w.planes[p];
-      if (!rolls_on(w, b, plane.normal)) continue;
-      Scalar gap = plane.normal.dot(b.position) - plane.offset - hull_radius(w, b, plane.normal);
+      if (!rolls_on<FS>(w, b, plane.normal)) continue;
+      Scalar gap = plane.normal.dot(b.position) - plane.offset - hull_radius<FS>(w, b, plane.normal);
       if (gap < 0) {
         b.position -= plane.normal * gap;
         gap = 0;
@@ -294,13 +294,16 @@ enum class SlopeSettle {
 /// downhill and takes none; where that set holds it, it settles into the nearest pose that
 /// holds on this plane, or, with none, stays where it is (it may sleep there, as a body propped
 /// out of its poses). Level ground (no pull along it) never gets here: its bits are unchanged.
-template <int D>
+template <class FS, int D>
 SlopeSettle settle_on_slope(const WorldData<D>& w, Body<D>& b, const typename Space<D>::Vec& n)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& shape = w.shapes[b.shape];
   const SignatureView<D>& sig = shape.signature;
   const WorldDef<D>& def = w.def;
+  if constexpr (!FS::slopes || !FS::statistical) {
+    return SlopeSettle::pose;
+  }
   if (!shape.statistical || !def.rest_conditions || sig.rest.count == 0 || !sig.contact.present())
     return SlopeSettle::pose;
   const Scalar gn = def.gravity.dot(n);

@@ -201,10 +201,10 @@ Scalar tip_over(const Shape<D>& shape, Body<D>& b, const typename Space<D>::Vec&
 
 /// Gravity's unit direction and magnitude for the tipping rule, or false when it does not apply
 /// (sphere contacts, or no gravity).
-template <int D>
+template <class FS, int D>
 bool tip_gravity(const WorldData<D>& w, typename Space<D>::Vec& unit, Scalar& magnitude)
 {
-  if (w.def.body_contacts != BodyContacts::hulls) return false;
+  if (!FS::hull_contacts || w.def.body_contacts != BodyContacts::hulls) return false;
   magnitude = w.def.gravity.norm();
   if (!(magnitude > 0)) return false;
   unit = w.def.gravity / magnitude;
@@ -216,12 +216,12 @@ bool tip_gravity(const WorldData<D>& w, typename Space<D>::Vec& unit, Scalar& ma
 /// that holds the upper body's centre of mass holds it outright (all sectors), one it overhangs
 /// from the overhang's side, a side contact from the side it pushes from. True when the upper body
 /// overhangs (a candidate for `tip_unsupported`).
-template <int D>
+template <class FS, int D>
 bool mark_supports(const WorldData<D>& w, Body<D>& a, Body<D>& b, const typename Space<D>::Vec& n,
                    const typename Space<D>::Vec& gravity_unit)
 {
   using Vec = typename Space<D>::Vec;
-  if (!hull_pair(w, a, b)) return false;
+  if (!hull_pair<FS>(w, a, b)) return false;
   Body<D>*lo, *up;
   Vec n_up;
   if (supporting(w, a, b, n, lo, up, n_up)) {
@@ -250,7 +250,7 @@ bool mark_supports(const WorldData<D>& w, Body<D>& a, Body<D>& b, const typename
 /// centre. One pass over the first `touching` pairs, whose contacts are taken as the passes after
 /// the impact pass take them (grown by `slop_fraction`, `contact_slop`), a fixed number of
 /// support map reads per contact (`support_overhang`).
-template <int D>
+template <class FS, int D>
 void tip_unsupported(WorldData<D>& w, std::uint32_t touching, const typename Space<D>::Vec& gravity_unit,
                      Scalar gravity, Scalar slop_fraction)
 {
@@ -260,10 +260,10 @@ void tip_unsupported(WorldData<D>& w, std::uint32_t touching, const typename Spa
     Body<D>& b = w.bodies[w.pairs[k].b];
     Contact<D> c;
     Scalar reach, pair_slop;
-    if (!body_contact(w, a, b, w.pairs[k], false, slop_fraction, c, reach, pair_slop,
+    if (!body_contact<FS>(w, a, b, w.pairs[k], false, slop_fraction, c, reach, pair_slop,
                       STATSIM_HULL_CACHE && k < w.max_pair_hulls ? &w.pair_hulls[k] : nullptr))
       continue;
-    if (!hull_pair(w, a, b)) continue;
+    if (!hull_pair<FS>(w, a, b)) continue;
     Body<D>*lo, *up;
     Vec n;
     // A body that chose a rest pose on the ground turns there (and keeps the pose while briefly
@@ -274,7 +274,7 @@ void tip_unsupported(WorldData<D>& w, std::uint32_t touching, const typename Spa
     for (std::uint32_t p = 0; p < w.plane_count; ++p) {
       const Plane<D>& plane = w.planes[p];
       Contact<D> pc;
-      if (!sphere_plane_contact<D>(up->position, plane_radius(w, *up, plane) + slop, plane, pc)) continue;
+      if (!sphere_plane_contact<D>(up->position, plane_radius<FS>(w, *up, plane) + slop, plane, pc)) continue;
       const std::uint32_t s = horizontal_sector<D>(plane.normal);
       up->supports = std::uint8_t(plane.normal[Space<D>::up_axis] >= Scalar(0.5) || s == 8 ? 0xffu
                                                                                            : (up->supports | (1u << s)));

@@ -33,7 +33,7 @@ void run_on_workers(const WorldData<D>& w, std::uint32_t count, std::uint32_t mi
 /// The fewest pairs worth a part of their own (a few tenths of a millisecond of searching).
 constexpr std::uint32_t witnesses_per_part = 512;
 
-template <int D>
+template <class FS, int D>
 void search_witnesses(std::uint32_t begin, std::uint32_t end, void* context)
 {
   WorldData<D>& w = *static_cast<WorldData<D>*>(context);
@@ -41,7 +41,7 @@ void search_witnesses(std::uint32_t begin, std::uint32_t end, void* context)
     Pair& pair = w.pairs[k];
     const Body<D>& a = w.bodies[pair.a];
     const Body<D>& b = w.bodies[pair.b];
-    if (!hull_pair(w, a, b)) continue;
+    if (!hull_pair<FS>(w, a, b)) continue;
     const Shape<D>& sa = w.shapes[a.shape];
     const Shape<D>& sb = w.shapes[b.shape];
     Scalar dist;
@@ -55,14 +55,14 @@ void search_witnesses(std::uint32_t begin, std::uint32_t end, void* context)
 /// (`search_witness`), searched before the pass on the workers: the pass changes velocities only
 /// (overlaps are corrected there only without `WorldDef::shock_propagation`), so the candidates
 /// are the ones it would find pair by pair. Returns false when the pass must search them itself.
-template <int D>
+template <class FS, int D>
 bool search_witnesses_first(WorldData<D>& w)
 {
 #if STATSIM_WORKERS
-  if (w.def.workers.count < 2 || w.def.body_contacts != BodyContacts::hulls || !w.def.shock_propagation ||
+  if (!FS::hull_contacts || w.def.workers.count < 2 || w.def.body_contacts != BodyContacts::hulls || !w.def.shock_propagation ||
       w.pair_count < 2 * witnesses_per_part)
     return false;
-  run_on_workers(w, w.pair_count, witnesses_per_part, &search_witnesses<D>, &w);
+  run_on_workers(w, w.pair_count, witnesses_per_part, &search_witnesses<FS, D>, &w);
   return true;
 #else
   (void)w;

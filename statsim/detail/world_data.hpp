@@ -9,6 +9,7 @@
 #include "statsim/detail/bits.hpp"
 #include "statsim/detail/grid.hpp"
 #include "statsim/detail/sweep.hpp"
+#include "statsim/features.hpp"
 #include "statsim/detail/ids.hpp"
 #include "statsim/detail/query_index.hpp"
 #include "statsim/random.hpp"
@@ -72,6 +73,9 @@ struct WorldData {
   bool sweep_current = false;
   bool grid_layout = false;  ///< the broad phase's block holds the grid (see `entries`)
   bool grid_storage = true;  ///< the block has room for the grid (`World`'s `Phases`)
+  /// What the world's step is compiled with (`World`'s `Features`): calls that need more are
+  /// refused (`refuses_features`).
+  Features features = Features::all;
   /// Some plane is tilted (`is_tilted_plane`): bodies meet tilted planes with their hulls.
   bool tilted_planes = false;
   std::uint64_t step_count = 0;
@@ -87,7 +91,9 @@ struct WorldData {
   std::uint32_t max_pair_hulls = 0;
 };
 
-/// What one step counts as its phases run; the passes reset the counter they test.
+/// What one step counts as its phases run; the passes reset the counter they test. `FS`: the
+/// world's `FeatureSet`, which the passes read from their context's type.
+template <class FS>
 struct StepContext {
   /// Body-body contacts of the impact pass: the pairs at the front of the pair buffer that the
   /// later passes visit.
@@ -125,11 +131,11 @@ constexpr Scalar pair_margin = Scalar(0.1);
 /// `pair_margin`, at most its bounding radius. A bunny's collision sphere is about 0.6 of its
 /// bounding radius: the grid's cells shrink to 0.66 of the bounding diameter, and their volume
 /// to 0.3; a pile's candidate pairs, and the pair buffer it needs, to a fifth.
-template <int D>
+template <class FS = AllFeatures, int D>
 Scalar pair_radius(const WorldData<D>& w, const Body<D>& b)
 {
   const Shape<D>& s = w.shapes[b.shape];
-  if (w.def.body_contacts == BodyContacts::hulls && has_hull(s)) return s.bounding_radius;
+  if (FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && has_hull(s)) return s.bounding_radius;
   const Scalar r = b.radius * (1 + pair_margin);
   return r < s.bounding_radius ? r : s.bounding_radius;
 }
@@ -176,11 +182,11 @@ void wake(WorldData<D>& w, Body<D>& b)
 /// True when the sleep test measures the body's centre from where its slow time began
 /// (`update_motion_states`): with hull contacts, for a shape whose table has body-body data (an
 /// older table steps exactly as with collision spheres).
-template <int D>
+template <class FS = AllFeatures, int D>
 bool sleeps_from_anchor(const WorldData<D>& w, const Body<D>& b)
 {
   const Shape<D>& s = w.shapes[b.shape];
-  return w.def.body_contacts == BodyContacts::hulls && s.statistical && s.signature.contact.present();
+  return FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && s.statistical && s.signature.contact.present();
 }
 
 }  // namespace detail
