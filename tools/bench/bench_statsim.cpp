@@ -2,6 +2,7 @@
 // the runtime's defaults (WorldDef), a ground plane and the scene's initial states.
 #include "bench/bench_internal.hpp"
 #include "common/task_pool.hpp"
+#include "scenes/body_def.hpp"
 
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
@@ -58,11 +59,7 @@ void fill_surface(const SignatureView<D>& sig, Surface& s)
 template <int D>
 void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::BodyState3& s)
 {
-  BodyDef<D> b;
-  b.position = s.position.cast<Scalar>();
-  b.orientation = s.orientation.cast<Scalar>().normalized();
-  b.linear_velocity = s.linear_velocity.cast<Scalar>();
-  b.angular_velocity = s.angular_velocity.cast<Scalar>();
+  BodyDef<D> b = scenes::body_def(s);
   b.shape = shape;
   b.mass = static_cast<Scalar>(mass);
   b.asleep = s.asleep;
@@ -73,11 +70,7 @@ void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::Bod
 template <int D>
 void add_body(WorldCore<D>& world, ShapeId shape, double mass, const scenes::BodyState2& s)
 {
-  BodyDef<D> b;
-  b.position = s.position.cast<Scalar>();
-  b.orientation = Rot2{static_cast<Scalar>(std::cos(s.angle)), static_cast<Scalar>(std::sin(s.angle))};
-  b.linear_velocity = s.linear_velocity.cast<Scalar>();
-  b.angular_velocity = static_cast<Scalar>(s.angular_velocity);
+  BodyDef<D> b = scenes::body_def(s);
   b.shape = shape;
   b.mass = static_cast<Scalar>(mass);
   const Added<BodyId> added = world.add_body(b);

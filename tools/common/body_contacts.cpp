@@ -1,7 +1,10 @@
 // See body_contacts.hpp.
 #include "common/body_contacts.hpp"
+#include "common/stored_values.hpp"
 
 #include "common/format.hpp"
+#include "common/pi.hpp"
+#include "common/sample_stats.hpp"
 #include "common/table_writer.hpp"
 #include "statsim/signature.hpp"
 
@@ -10,30 +13,6 @@
 #include <cstdint>
 
 namespace statsim::tools {
-
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-struct MeanStd {
-  double mean = 0.0, std = 0.0;
-};
-
-MeanStd mean_std(const std::vector<double>& v)
-{
-  MeanStd s;
-  if (v.empty()) return s;
-  double sum = 0.0;
-  for (double x : v) sum += x;
-  s.mean = sum / static_cast<double>(v.size());
-  if (v.size() < 2) return s;
-  double sq = 0.0;
-  for (double x : v) sq += (x - s.mean) * (x - s.mean);
-  s.std = std::sqrt(sq / static_cast<double>(v.size() - 1));
-  return s;
-}
-
-}  // namespace
 
 int packing_bin(double up, double length)
 {
@@ -106,19 +85,9 @@ std::string contact_entries(const BodyContactData& c, bool i16, double* i16_erro
   s += c.dims == 3 ? "      // support map (m): face f = 2 m + (u_m < 0), value (f S + i) S + j, node -1 + 2 i / (S - 1)\n"
                    : "      // support map (m): side f = 2 m + (u_m < 0), value f S + i, node -1 + 2 i / (S - 1)\n";
   if (i16) {
-    std::vector<float> f;
-    for (double v : c.support) f.push_back(static_cast<float>(v) + 0.0f);
-    std::vector<std::int16_t> q(f.size());
-    float scale = 1, offset = 0;
-    statsim::quantize16(f.data(), f.size(), scale, offset, q.data());
-    double worst = 0.0;
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      // As the runtime dequantises: offset + scale * Scalar(q), in float.
-      const float back = offset + scale * static_cast<float>(q[i]);
-      worst = std::max(worst, std::fabs(static_cast<double>(back) - static_cast<double>(f[i])));
-    }
-    if (i16_error) *i16_error = worst;
-    s += entry("{" + hex_floats({scale, offset}) + ", " + int_array(q, ArrayStyle{12, 8, false, 6}) + "}",
+    const Quantized q = quantize(to_float(c.support));
+    if (i16_error) *i16_error = q.worst_error;
+    s += entry("{" + hex_floats({q.scale, q.offset}) + ", " + int_array(q.q, ArrayStyle{12, 8, false, 6}) + "}",
                "scale, offset, values");
   } else {
     s += entry(inner(c.support, 6));

@@ -77,20 +77,42 @@ double radius_of(const std::vector<V>& hull)
   return r;
 }
 
+template <class V>
+double support_of(const std::vector<V>& hull, const V& u)
+{
+  double s = -std::numeric_limits<double>::infinity();
+  for (const V& p : hull) s = std::max(s, u.dot(p));
+  return s;
+}
+
+// lookup - support over the directions direction(0) .. direction(n - 1), taken in that order.
+template <class Map, class V, class Direction>
+SupportError error_over(const Map& map, const std::vector<V>& hull, int n, Direction&& direction)
+{
+  SupportError e;
+  e.min = std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const V u = direction(k);
+    const double d = map.lookup(u) - support_of(hull, u);
+    sum += d;
+    e.max = std::max(e.max, d);
+    e.min = std::min(e.min, d);
+  }
+  e.mean = n > 0 ? sum / n : 0.0;
+  return e;
+}
+
 }  // namespace
 
 double support(const std::vector<Eigen::Vector3d>& hull, const Eigen::Vector3d& u)
 {
-  double s = -std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector3d& p : hull) s = std::max(s, u.dot(p));
-  return s;
+  return support_of(hull, u);
 }
 
 double support(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& u)
 {
-  double s = -std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector2d& p : hull) s = std::max(s, u.dot(p));
-  return s;
+  return support_of(hull, u);
 }
 
 // ---- 3D --------------------------------------------------------------------------------------
@@ -148,20 +170,11 @@ double SupportMap3::error_bound(const std::vector<Eigen::Vector3d>& hull, int su
 SupportError measure_support_error(const SupportMap3& map, const std::vector<Eigen::Vector3d>& hull, int n)
 {
   Stream rng(0x5eed5a99ull);
-  SupportError e;
-  e.min = std::numeric_limits<double>::infinity();
-  double sum = 0.0;
-  for (int k = 0; k < n; ++k) {
+  return error_over(map, hull, n, [&rng](int) {
     const double z = 2.0 * rng.uniform() - 1.0, phi = 6.283185307179586 * rng.uniform();
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Eigen::Vector3d u(r * std::cos(phi), r * std::sin(phi), z);
-    const double d = map.lookup(u) - support(hull, u);
-    sum += d;
-    e.max = std::max(e.max, d);
-    e.min = std::min(e.min, d);
-  }
-  e.mean = n > 0 ? sum / n : 0.0;
-  return e;
+    return Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
+  });
 }
 
 // ---- 2D --------------------------------------------------------------------------------------
@@ -211,20 +224,11 @@ double SupportMap2::error_bound(const std::vector<Eigen::Vector2d>& hull, int su
 
 SupportError measure_support_error(const SupportMap2& map, const std::vector<Eigen::Vector2d>& hull, int n)
 {
-  SupportError e;
-  e.min = std::numeric_limits<double>::infinity();
-  double sum = 0.0;
-  for (int k = 0; k < n; ++k) {
+  return error_over(map, hull, n, [n](int k) {
     // Evenly spaced angles, offset by half a step: the circle covered without a generator.
     const double phi = 6.283185307179586 * (static_cast<double>(k) + 0.5) / n;
-    const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
-    const double d = map.lookup(u) - support(hull, u);
-    sum += d;
-    e.max = std::max(e.max, d);
-    e.min = std::min(e.min, d);
-  }
-  e.mean = n > 0 ? sum / n : 0.0;
-  return e;
+    return Eigen::Vector2d(std::cos(phi), std::sin(phi));
+  });
 }
 
 }  // namespace statsim::tools

@@ -1,5 +1,7 @@
 #include "ref2d/box2d_util.hpp"
 
+#include "common/pi.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,7 +11,6 @@
 namespace statsim::tools {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxSteps = 1000000;
 
 double wrap_angle(double a)

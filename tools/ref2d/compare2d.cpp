@@ -1,6 +1,9 @@
 // `statsim compare2d`: see compare2d.hpp.
 #include "ref2d/compare2d.hpp"
 
+#include "common/format.hpp"
+#include "common/pi.hpp"
+
 #include "common/atomic_file.hpp"
 #include "common/progress.hpp"
 #include "ref2d/box2d_util.hpp"
@@ -27,7 +30,6 @@
 namespace statsim::tools {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxBodies = 2048;
 using StatWorld = statsim::World2<kMaxBodies>;
 
@@ -47,13 +49,6 @@ Shape2 shape_for(const std::string& shape)
     return lshape_shape();
   }
   throw std::invalid_argument("unknown shape '" + shape + "' (square or lshape)");
-}
-
-std::string fmt(const char* format, double x)
-{
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, x);
-  return buf;
 }
 
 double median(std::vector<double> v)

@@ -37,6 +37,7 @@
 // body), shared with `statsim gather2d`'s collision-height table.
 #include "ref2d/fig3.hpp"
 
+#include "common/pi.hpp"
 #include "common/atomic_file.hpp"
 #include "common/parallel.hpp"
 #include "common/plot.hpp"
@@ -59,7 +60,6 @@ namespace statsim::tools {
 namespace {
 
 constexpr double kHalfDiagonal = 0.70710678118654752440;  // sqrt(2)/2: circumradius of the square
-constexpr double kPi = 3.14159265358979323846;
 // Start clearance above the highest possible first-contact height: Box2D's fat-AABB margin, so
 // the drop begins with no pair in the broad phase and takes several free steps.
 constexpr double kClearance = 0.1;

@@ -1,5 +1,6 @@
 #include "ref2d/pairs2d.hpp"
 
+#include "common/pi.hpp"
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
 #include "common/parallel.hpp"
@@ -26,8 +27,6 @@
 namespace statsim::tools {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Shape2 shape_of(const std::string& name)
 {

@@ -1,5 +1,7 @@
 #include "ref3d/pairs.hpp"
 
+#include "common/pi.hpp"
+
 #include "bullet/bullet.hpp"
 #include "bullet/drop_world.hpp"
 #include "common/format.hpp"
@@ -29,8 +31,6 @@
 namespace statsim::tools::ref3d {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 btTransform to_bt(const RigidState& s)
 {

@@ -9,6 +9,7 @@
 #include "mesh/mesh.hpp"
 #include "bullet/drop_world.hpp"
 #include "render/frames.hpp"
+#include "scenes/body_def.hpp"
 #include "scenes/scenes.hpp"
 #include "statsim/world3.hpp"
 #include "tables/bunny.hpp"
@@ -104,11 +105,7 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
     }
     const ShapeId shape = added.id;
     for (const scenes::BodyState3& s : scene.bodies) {
-      BodyDef3 b;
-      b.position = s.position.cast<Scalar>();
-      b.orientation = s.orientation.cast<Scalar>().normalized();
-      b.linear_velocity = s.linear_velocity.cast<Scalar>();
-      b.angular_velocity = s.angular_velocity.cast<Scalar>();
+      BodyDef3 b = scenes::body_def(s);
       b.shape = shape;
       b.mass = sig.mass;
       if (!w.add_body(b).ok()) {

@@ -7,6 +7,7 @@
 #include "stress/snapshot_cells.hpp"
 #include "common/format.hpp"
 
+#include "scenes/body_def.hpp"
 #include "scenes/scenes.hpp"
 #include "statsim/snapshot.hpp"
 #include "tables/bunny.hpp"
@@ -91,12 +92,7 @@ void snapshot_cells(bool want3, bool want2, bool hull_contacts, const AddCell& a
       if (!ok) throw std::runtime_error("stress snapshot: set-up");
     }
     for (const scenes::BodyState3& s : scene.bodies) {
-      BodyDef3 d;
-      d.position = s.position.cast<Scalar>();
-      d.orientation = s.orientation.cast<Scalar>().normalized();
-      d.linear_velocity = s.linear_velocity.cast<Scalar>();
-      d.angular_velocity = s.angular_velocity.cast<Scalar>();
-      if (!a->add_body(d).ok()) throw std::runtime_error("stress snapshot: add_body");
+      if (!a->add_body(scenes::body_def(s)).ok()) throw std::runtime_error("stress snapshot: add_body");
     }
     run_pile<3>(*a, *b, "snapshot, pile of 300 bunnies", "statistical", add);
   }

@@ -13,6 +13,7 @@
 #include "common/progress.hpp"
 
 #include "bench/bench_internal.hpp"
+#include "scenes/body_def.hpp"
 #include "scenes/scenes.hpp"
 
 #include "statsim/queries.hpp"
@@ -114,11 +115,7 @@ public:
     mass_ = static_cast<double>(sig_.mass);
     for (std::size_t i = 0; i < states.size(); ++i) {
       const scenes::BodyState3& s = states[i];
-      BodyDef3 b;
-      b.position = s.position.cast<Scalar>();
-      b.orientation = s.orientation.cast<Scalar>().normalized();
-      b.linear_velocity = s.linear_velocity.cast<Scalar>();
-      b.angular_velocity = s.angular_velocity.cast<Scalar>();
+      BodyDef3 b = scenes::body_def(s);
       b.shape = shape.id;
       b.mass = static_cast<Scalar>(mass_ * (setup.mass_scale.empty() ? 1.0 : setup.mass_scale[i]));
       const Added<BodyId> added = world_->add_body(b);

@@ -1,0 +1,90 @@
+// See gather_trials.hpp.
+#include "ref3d/gather_trials.hpp"
+
+#include "common/pi.hpp"
+#include "ref3d/sampling.hpp"
+#include "statsim/detail/response.hpp"
+#include "statsim/statistical.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace statsim::tools::ref3d {
+
+double height_trial(const ShapeModel& m, double spin_ratio, std::uint64_t seed, std::uint64_t index)
+{
+  TrialRng rng(seed, kHeightStream, index);
+  const double L = m.bounding_radius, u = 1.0;
+  RigidState s;
+  s.orientation = rng.rotation();
+  s.spin = rng.direction() * (spin_ratio * u / L);
+  s.velocity = Eigen::Vector3d(0, 0, -u);
+  s.position = Eigen::Vector3d(0, 0, L * (1 + 1e-9));
+  const FreeFlight flight(m.unit_inertia);
+  const FirstContact fc = first_contact(m.hull, L, flight, s, 0.0, std::numeric_limits<double>::infinity(),
+                                        1e-12 * L, 100000000);
+  return fc.state.position.z() - lowest_point(m.hull, fc.state);
+}
+
+ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, double cos_theta, double cos_phi,
+                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index)
+{
+  const ShapeModel& m = ref.model();
+  TrialRng rng(o.seed, stream, index);
+  const double L = m.bounding_radius;
+  const double ct = cos_theta, st = std::sqrt(std::max(0.0, 1.0 - ct * ct));
+  const Eigen::Vector3d vhat(st, 0.0, -ct), e1(ct, 0.0, st), e2(0.0, 1.0, 0.0);
+  const double azimuth = 2.0 * kPi * rng.uniform();
+  const double alpha = ct >= 1.0 ? 0.0 : azimuth;
+  const double sp = std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi));
+  const Eigen::Vector3d wdir = cos_phi * vhat + sp * (std::cos(alpha) * e1 + std::sin(alpha) * e2);
+
+  RigidState s0;
+  s0.orientation = rng.rotation();
+  s0.velocity = speed * vhat;
+  s0.spin = wdir * (spin_ratio * speed / L);
+  s0.position = Eigen::Vector3d(0, 0, L * (1 + 1e-9));
+  const FreeFlight flight(m.unit_inertia);
+  const FirstContact fc = first_contact(m.hull, L, flight, s0, 0.0, std::numeric_limits<double>::infinity(),
+                                        1e-12 * L, 100000000);
+  RigidState start = fc.state;
+  start.position.z() -= 1e-6 * L;  // a hair into the ground, so that Bullet's first step has the contact
+  const ImpactResult ir = ref.impact(start, o.max_impact_time);
+
+  const Material mat{static_cast<Scalar>(o.reference.restitution), static_cast<Scalar>(o.reference.friction),
+                     static_cast<Scalar>(o.rolling_resistance)};
+  const Vector3 vminus = s0.velocity.cast<Scalar>();
+  const Vector3 vp = point_particle_velocity<3>(vminus, Vector3(0, 0, 1), mat,
+                                                static_cast<Scalar>(o.reference.restitution_threshold));
+  ResponseTrial out;
+  const Eigen::Vector3d w = ir.after.spin * (L / speed);
+  const Eigen::Vector3d dv = (ir.after.velocity - vp.cast<double>()) / speed;
+  out.value = {w.x(), w.y(), w.z(), dv.x(), dv.y(), dv.z()};
+  out.time_limited = ir.time_limited;
+  out.max_penetration = ir.max_penetration;
+  out.steps = ir.steps;
+  return out;
+}
+
+DropTrial drop_trial(const Reference& ref, const GatherOptions& o, std::uint64_t index)
+{
+  const ShapeModel& m = ref.model();
+  TrialRng rng(o.seed, kRestStream, index);
+  const double L = m.bounding_radius;
+  RigidState s;
+  s.orientation = rng.rotation();
+  s.velocity = Eigen::Vector3d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+  s.spin = rng.direction() * rng.uniform(0, 4 * kPi);
+  const double lift = L * rng.uniform(0.25, 3.0);
+  s.position = Eigen::Vector3d(0, 0, -lowest_point(m.hull, s) + lift);
+  const DropResult r = ref.drop(s, o.still_speed, o.still_time, o.max_drop_time);
+  DropTrial d;
+  d.up = r.rest.orientation.conjugate() * Eigen::Vector3d::UnitZ();
+  d.height = r.height;
+  d.time = r.time;
+  d.settled = r.settled;
+  return d;
+}
+
+}  // namespace statsim::tools::ref3d

@@ -1,0 +1,44 @@
+// The reference trials of `statsim gather` in Bullet, one at a time: an h_coll flight (exact,
+// no stepping), a response impact, a rest drop. Each is seeded from (seed, stream, index) only,
+// so a trial's outcome does not depend on which thread runs it or in which order.
+#pragma once
+
+#include "ref3d/gather_options.hpp"
+#include "ref3d/model.hpp"
+#include "ref3d/reference.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+
+namespace statsim::tools::ref3d {
+
+/// One impact's normalised outcome: W+ L/|V-| (3), (V+ - V_particle+)/|V-| (3).
+using Response = std::array<double, 6>;
+
+/// One response trial: W+ and V+ of one impact, and how Bullet got there.
+struct ResponseTrial {
+  Response value{};
+  bool time_limited = false;
+  double max_penetration = 0.0;
+  int steps = 0;
+};
+/// The impact of cell (cos theta, cos phi, speed, spin ratio), trial `index` of `stream`.
+ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, double cos_theta, double cos_phi,
+                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index);
+
+/// One h_coll flight: the centre height at first contact.
+double height_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index);
+
+/// One rest drop: where the body's up vector ended (body frame), at what height, after how long.
+struct DropTrial {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  double height = 0.0;
+  double time = 0.0;
+  bool settled = false;
+};
+/// Drop `index`: a random pose and velocity with gravity until the body is still.
+DropTrial drop_trial(const Reference& ref, const GatherOptions& o, std::uint64_t index);
+
+}  // namespace statsim::tools::ref3d
