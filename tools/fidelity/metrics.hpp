@@ -48,4 +48,17 @@ Interval bootstrap(std::size_t n_a, std::size_t n_b,
 /// 0, 1, ..., n - 1.
 std::vector<std::size_t> iota(std::size_t n);
 
+/// The bootstrap interval of get(stats(method, reference)) over resamples of both samples.
+template <class Run, class Stats, class Get>
+Interval resampled(const std::vector<Run>& method, const std::vector<Run>& reference, const Stats& stats,
+                   const Get& get, int resamples)
+{
+  return bootstrap(
+      method.size(), reference.size(),
+      [&](const std::vector<std::size_t>& ia, const std::vector<std::size_t>& ib) {
+        return get(stats(pick(method, ia), pick(reference, ib)));
+      },
+      resamples);
+}
+
 }  // namespace statsim::tools::fidelity
