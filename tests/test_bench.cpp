@@ -10,6 +10,7 @@
 #include <doctest/doctest.h>
 
 #include "support/csv.hpp"
+#include "support/text_file.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -41,22 +42,8 @@ bool same(const scenes::BodyState3& a, const scenes::BodyState3& b)
 
 using statsim::testing::csv_fields;
 
-std::string read_file(const std::filesystem::path& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::vector<std::string> lines_of(const std::string& text)
-{
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) lines.push_back(line);
-  return lines;
-}
+using statsim::testing::lines_of;
+using statsim::testing::read_file;
 
 void check_cells(const BenchResult& r)
 {

@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 
 #include "support/csv.hpp"
+#include "support/text_file.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -24,23 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_text(const fs::path& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  REQUIRE_MESSAGE(in.good(), "cannot read " << path.string());
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::vector<std::string> lines_of(const std::string& text)
-{
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    lines.push_back(line);
-  return lines;
-}
+using statsim::testing::lines_of;
+using statsim::testing::read_text;
 
 // ---- CSV --------------------------------------------------------------------------------------
 

@@ -1,6 +1,9 @@
-// Test fixtures for the tests of the host tools: a fresh temporary directory and whole-file reads.
+// Test fixtures for the tests of the host tools: a fresh temporary directory (and, through
+// text_file.hpp, whole-file reads).
 // Tests only (the doctest REQUIRE in the constructor).
 #pragma once
+
+#include "support/text_file.hpp"
 
 #include <doctest/doctest.h>
 
@@ -53,12 +56,5 @@ struct TempDir {
     return names;
   }
 };
-
-/// The whole content of a file ("" if it cannot be read).
-inline std::string read_file(const std::filesystem::path& p)
-{
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 }  // namespace statsim::testing
