@@ -3,7 +3,7 @@
 // Tests only (the doctest REQUIRE in the constructor).
 #pragma once
 
-#include "support/text_file.hpp"
+#include "text_file.hpp"  // beside this file
 
 #include <doctest/doctest.h>
 
