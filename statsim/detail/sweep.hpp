@@ -58,9 +58,10 @@ inline std::uint32_t insertion_sort(SweepEntry* entries, std::uint32_t count)
 /// (a settled pile of sleepers costs nearly nothing). `entries` must be sorted by lo. From each
 /// active entry it scans forward until lo passes its hi, and backward for inactive entries whose
 /// interval reaches it: sorted by lo, those start no earlier than lo - `max_width`, the widest
-/// interval.
+/// interval. `overlap` is taken by value: a copy of its own, whose captures the compiler can keep
+/// in registers through the loops (through a reference it reloads them at every pair).
 template <class OnOverlap>
-void sweep_active(const SweepEntry* entries, std::uint32_t count, Scalar max_width, OnOverlap&& overlap)
+void sweep_active(const SweepEntry* entries, std::uint32_t count, Scalar max_width, OnOverlap overlap)
 {
   for (std::uint32_t i = 0; i < count; ++i) {
     if (!entries[i].active) continue;

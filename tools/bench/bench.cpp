@@ -337,6 +337,8 @@ private:
     c += " --dt " + fmt("%.9g", o_.dt) + " --steps " + std::to_string(o_.steps) + " --warmup " +
          std::to_string(o_.warmup) + " --repeat " + std::to_string(o_.repeats) + " --limit-ms " +
          fmt("%g", o_.limit_ms) + " --budget-s " + fmt("%g", o_.budget_s) + " --seed " + std::to_string(o_.seed);
+    if (!o_.hull_contacts) c += " --body-contacts spheres";
+    if (o_.all_features) c += " --all-features";
     return c;
   }
 
@@ -347,6 +349,7 @@ private:
     StatsimVariant v;
     v.hull_contacts = o_.hull_contacts;
     v.workers = o_.workers;
+    v.all_features = o_.all_features;
     if (o_.dim == 3) return make_statsim3(body3_, *s3, o_.seed, o_.dt, forced_broad_phase(k.method), v);
     return make_statsim2(body2_, *s2, o_.seed, o_.dt, forced_broad_phase(k.method), v);
   }

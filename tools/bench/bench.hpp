@@ -54,6 +54,7 @@ struct BenchOptions {
   bool chart_cpu = false;            ///< chart the thread CPU time instead of the wall-clock median
   bool hull_contacts = true;         ///< statsim: BodyContacts::hulls (false: the default, collision spheres)
   unsigned workers = 1;              ///< statsim: threads stepping each world (WorldDef::workers)
+  bool all_features = false;         ///< statsim 3D: `Features::all`, not the scene's smallest set
 };
 
 /// One cell of the benchmark: a method at one N with one broad phase.

@@ -131,6 +131,9 @@ void register_bench_commands(CLI::App& app)
                 "runtime's default)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"hulls", true}, {"spheres", false}}))
       ->default_str("hulls");
+  b->add_flag("--all-features", o.all_features,
+              "statsim 3D: worlds compiled with every feature (Features::all) instead of the smallest set that covers "
+              "the scene (statsim/features.hpp); the same bits, more code in the step");
   b->add_option("--workers", o.workers, "statsim: threads stepping each world (WorldDef::workers), 1 to 64")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();

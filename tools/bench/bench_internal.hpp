@@ -178,6 +178,9 @@ struct StatsimVariant {
   bool hull_contacts = true;
   /// Threads stepping the world (WorldDef::workers, through a tools::TaskPool); 1: none started.
   unsigned workers = 1;
+  /// A 3D world compiled with every feature (`Features::all`) instead of the smallest set that
+  /// covers the scene (statsim/features.hpp); the bits are the same either way.
+  bool all_features = false;
 };
 /// A statsim world with any signature (e.g. one loaded at run time); `sig`'s storage must outlive it.
 /// `walls`: static planes besides the ground (at most 7).

@@ -86,12 +86,12 @@ struct ShapeSet {
   std::vector<int> of_body;
 };
 
-/// A statsim world of capacity `Cap` with the scene's bodies and the ground.
-template <int D, std::uint32_t Cap>
+/// A statsim world of capacity `Cap` and features `F` with the scene's bodies and the ground.
+template <int D, std::uint32_t Cap, Features F>
 class StatsimSim final : public Sim {
 public:
   // Planes: the ground and up to 7 more (the bin scene's four walls). Shapes: up to 2.
-  using WorldT = World<D, Cap, 8, Cap * kPairsPerBody, 2>;
+  using WorldT = World<D, Cap, 8, Cap * kPairsPerBody, 2, 0, BroadPhase::automatic, F>;
 
   template <class Scene>
   StatsimSim(const ShapeSet<D>& set, const Scene& scene, std::uint64_t seed, double dt,
@@ -194,20 +194,43 @@ private:
   std::uint32_t worst_dropped_ = 0;
 };
 
+template <int D, Features F, class Scene>
+std::unique_ptr<Sim> make_capacity(const ShapeSet<D>& sig, const Scene& scene, std::uint64_t seed, double dt,
+                                   const std::string& broad_phase, const StatsimVariant& v,
+                                   const std::vector<bullet::Plane>& w)
+{
+  const std::size_t n = scene.bodies.size();
+  if (n <= 16) return std::make_unique<StatsimSim<D, 16, F>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 128) return std::make_unique<StatsimSim<D, 128, F>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024, F>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096, F>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384, F>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= 32768) return std::make_unique<StatsimSim<D, 32768, F>>(sig, scene, seed, dt, broad_phase, v, w);
+  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity, F>>(sig, scene, seed, dt, broad_phase, v, w);
+  throw std::runtime_error("statsim bench worlds hold at most " + std::to_string(kCapacity) + " bodies");
+}
+
+/// A world of the features the scene uses, as a user would compile it (statsim/features.hpp):
+/// statistical shapes, hull contacts where the variant asks for them, slopes where a wall is
+/// tilted; every feature with `StatsimVariant::all_features`. 3D only: the 2D bench keeps every
+/// feature, so that the tool compiles a third as many steps.
 template <int D, class Scene>
 std::unique_ptr<Sim> make_sized(const ShapeSet<D>& sig, const Scene& scene, std::uint64_t seed, double dt,
                                 const std::string& broad_phase, const StatsimVariant& v = {},
                                 const std::vector<bullet::Plane>& w = {})
 {
-  const std::size_t n = scene.bodies.size();
-  if (n <= 16) return std::make_unique<StatsimSim<D, 16>>(sig, scene, seed, dt, broad_phase, v, w);
-  if (n <= 128) return std::make_unique<StatsimSim<D, 128>>(sig, scene, seed, dt, broad_phase, v, w);
-  if (n <= 1024) return std::make_unique<StatsimSim<D, 1024>>(sig, scene, seed, dt, broad_phase, v, w);
-  if (n <= 4096) return std::make_unique<StatsimSim<D, 4096>>(sig, scene, seed, dt, broad_phase, v, w);
-  if (n <= 16384) return std::make_unique<StatsimSim<D, 16384>>(sig, scene, seed, dt, broad_phase, v, w);
-  if (n <= 32768) return std::make_unique<StatsimSim<D, 32768>>(sig, scene, seed, dt, broad_phase, v, w);
-  if (n <= kCapacity) return std::make_unique<StatsimSim<D, kCapacity>>(sig, scene, seed, dt, broad_phase, v, w);
-  throw std::runtime_error("statsim bench worlds hold at most " + std::to_string(kCapacity) + " bodies");
+  if constexpr (D == 3) {
+    bool tilted = false;
+    for (const bullet::Plane& p : w) {
+      Scalar gn;
+      tilted = tilted || detail::is_tilted_plane(WorldDef3{}.gravity, Vector3(p.normal.cast<Scalar>().normalized()), gn);
+    }
+    if (!v.all_features && !tilted) {
+      if (v.hull_contacts) return make_capacity<D, Features::piles>(sig, scene, seed, dt, broad_phase, v, w);
+      return make_capacity<D, Features::paper>(sig, scene, seed, dt, broad_phase, v, w);
+    }
+  }
+  return make_capacity<D, Features::all>(sig, scene, seed, dt, broad_phase, v, w);
 }
 
 }  // namespace
