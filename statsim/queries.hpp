@@ -208,7 +208,7 @@ Status ray_cast_all(const WorldCore<D>& world, const typename Space<D>::Vec& ori
   const Scalar len = direction.norm();
   if (!(len > Scalar(1e-12))) return Status::invalid_parameter;
   const Vec d = direction / len;
-  const detail::WorldData<D>& w = world.data();
+  const detail::WorldData<D>& w = detail::CoreAccess::data(world);
   QueryStats own;
   QueryStats& st = stats != nullptr ? *stats : own;
   const Vec end = origin + d * max_distance;
@@ -242,7 +242,7 @@ Status ray_cast(const WorldCore<D>& world, const typename Space<D>::Vec& origin,
   const Scalar len = direction.norm();
   if (!(len > Scalar(1e-12))) return Status::invalid_parameter;
   const Vec d = direction / len;
-  const detail::WorldData<D>& w = world.data();
+  const detail::WorldData<D>& w = detail::CoreAccess::data(world);
   QueryStats own;
   QueryStats& st = stats != nullptr ? *stats : own;
   QueryHit<D> best;
@@ -287,7 +287,7 @@ Status overlap_sphere(const WorldCore<D>& world, const typename Space<D>::Vec& c
   using Vec = typename Space<D>::Vec;
   const Status s = detail::check_query<D>(world, center, Vec::Zero(), radius);
   if (s != Status::ok) return s;
-  const detail::WorldData<D>& w = world.data();
+  const detail::WorldData<D>& w = detail::CoreAccess::data(world);
   QueryStats own;
   QueryStats& st = stats != nullptr ? *stats : own;
   const int done = detail::in_slot_order(

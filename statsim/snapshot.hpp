@@ -402,7 +402,7 @@ constexpr std::size_t snapshot_capacity(std::uint32_t max_bodies, std::uint32_t 
 template <int D>
 std::size_t snapshot_size(const WorldCore<D>& world)
 {
-  return detail::write_snapshot(world.data(), nullptr);
+  return detail::write_snapshot(detail::CoreAccess::data(world), nullptr);
 }
 
 /// Writes the world's state into `buf` (`cap` bytes) and its size into `*written` (when not
@@ -414,7 +414,7 @@ Status save(const WorldCore<D>& world, unsigned char* buf, std::size_t cap, std:
   const std::size_t n = snapshot_size(world);
   if (written != nullptr) *written = n;
   if (buf == nullptr || n > cap) return Status::capacity_exceeded;
-  detail::write_snapshot(world.data(), buf);
+  detail::write_snapshot(detail::CoreAccess::data(world), buf);
   return Status::ok;
 }
 

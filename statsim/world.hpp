@@ -50,6 +50,7 @@
 namespace statsim {
 namespace detail {
 struct SnapshotAccess;  // statsim/snapshot.hpp: `load` writes a world's arrays
+struct CoreAccess;      // below: the runtime's own read access to a world's arrays
 }  // namespace detail
 
 /// Capacity-erased world: all the logic, working on storage that `World<>` provides.
@@ -275,8 +276,6 @@ class WorldCore {
 
   /// The id of the body in slot `slot` (< body_count()), or `no_body` for a free slot.
   BodyId id_of(std::uint32_t slot) const { return w_.slots.id(slot, w_.body_count); }
-  /// The world's arrays, for the queries of statsim/queries.hpp: internal, their layout may change.
-  const detail::WorldData<D>& data() const { return w_; }
 
   /// Number of bodies in each motion state.
   std::uint32_t count(MotionState s) const
@@ -422,12 +421,25 @@ class WorldCore {
 
  private:
   friend struct detail::SnapshotAccess;
+  friend struct detail::CoreAccess;
   detail::WorldData<D> w_;
   detail::ImpactLog<D> impacts_;
   StepResult (*step_)(WorldCore&, Scalar);
   Status construction_status_ = Status::ok;
   std::uint16_t tag_ = detail::next_world_tag();
 };
+
+namespace detail {
+/// A world's arrays, read by the runtime's own code outside the world (queries, snapshots) and by
+/// tests and tools that check internals: not part of the public API, their layout may change.
+struct CoreAccess {
+  template <int D>
+  static const WorldData<D>& data(const WorldCore<D>& world)
+  {
+    return world.w_;
+  }
+};
+}  // namespace detail
 
 /// A world of at most `MaxBodies` bodies, `MaxPlanes` planes, `MaxPairs` candidate pairs per step
 /// (a settling pile of equal spheres needs about 6 per body; raise it if `step()` reports

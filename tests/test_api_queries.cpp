@@ -224,7 +224,7 @@ int compare_queries(const W& w, Pcg32& g, float half)
     REQUIRE(ray_cast_all(w, o, dir, len, [&](const QueryHit<D>& h) { return fast.add(h); }, &st) == Status::ok);
     QueryStats scan;
     const Vec d = dir / dir.norm();
-    detail::ray_cast_all_scan(w.data(), o, d, len, [&](const QueryHit<D>& h) { return slow.add(h); }, scan);
+    detail::ray_cast_all_scan(detail::CoreAccess::data(w), o, d, len, [&](const QueryHit<D>& h) { return slow.add(h); }, scan);
     CHECK(fast == slow);
     searched += !st.scanned;
     // The nearest hit: the first strictly nearer one in the scan's order.
@@ -242,7 +242,7 @@ int compare_queries(const W& w, Pcg32& g, float half)
     Hits<D> over, over_slow;
     QueryStats so;
     REQUIRE(overlap_sphere(w, o, r, [&](const QueryHit<D>& h) { return over.add(h); }, &so) == Status::ok);
-    detail::overlap_sphere_scan(w.data(), o, r, [&](const QueryHit<D>& h) { return over_slow.add(h); }, scan);
+    detail::overlap_sphere_scan(detail::CoreAccess::data(w), o, r, [&](const QueryHit<D>& h) { return over_slow.add(h); }, scan);
     CHECK(over == over_slow);
     searched += !so.scanned;
   }
@@ -357,7 +357,7 @@ TEST_CASE("a query in a sparse region visits few of the world's bodies")
     }
     // A scan reads every slot.
     QueryStats scan;
-    detail::overlap_sphere_scan(w->data(), Vector3(0.1f, 0.1f, 0.1f), 0.15f, count, scan);
+    detail::overlap_sphere_scan(detail::CoreAccess::data(*w), Vector3(0.1f, 0.1f, 0.1f), 0.15f, count, scan);
     CHECK(scan.bodies_examined == 2000);
   }
 }

@@ -181,7 +181,7 @@ TEST_CASE("the state hash tells a reused slot's generation")
     REQUIRE(w->remove_body(first) == Status::ok);  // slot 0 free, generation 1
   }
   CHECK(a->state_hash() == b->state_hash());
-  ++b->data().slots.generation[0];  // the array is the world's own: not part of the const view
+  ++detail::CoreAccess::data(*b).slots.generation[0];  // the array is the world's own: not part of the const view
   CHECK(a->state_hash() != b->state_hash());
   CHECK(a->add_body(bd).id != b->add_body(bd).id);
 }

@@ -97,8 +97,8 @@ void check_scene(const WorldDef<D>& def, int save_at, bool mixed = true)
   CHECK(a->live_body_count() < a->body_count());
   std::uint32_t touching = 0;
   for (std::uint32_t i = 0; i < a->body_count(); ++i) {
-    touching += a->data().bodies[i].touching;
-    anchors += detail::keeps_step_start(a->data(), a->data().bodies[i]);
+    touching += detail::CoreAccess::data(*a).bodies[i].touching;
+    anchors += detail::keeps_step_start(detail::CoreAccess::data(*a), detail::CoreAccess::data(*a).bodies[i]);
   }
   if (mixed) {
     CHECK(a->count(MotionState::moving) + a->count(MotionState::settling) > 0);
@@ -350,7 +350,7 @@ TEST_CASE("snapshot: queries after a load find what testing every body finds")
           return true;
         });
         REQUIRE(s == Status::ok);
-        detail::overlap_sphere_scan(b->data(), c, Scalar(0.15f), [&](const QueryHit<3>& h) {
+        detail::overlap_sphere_scan(detail::CoreAccess::data(*b), c, Scalar(0.15f), [&](const QueryHit<3>& h) {
           if (h.body != no_body) scanned.push_back(h.body);
           return true;
         }, st);

@@ -108,11 +108,11 @@ int main(int argc, char** argv)
         QueryStats s2;
         for (const Query& q : queries) {
           if (overlap) {
-            detail::overlap_sphere_scan(w->data(), Vector3(q.origin - Vector3(0, 0, 2.9f)), 0.2f,
+            detail::overlap_sphere_scan(detail::CoreAccess::data(*w), Vector3(q.origin - Vector3(0, 0, 2.9f)), 0.2f,
                                         [&sink](const QueryHit<3>& h) { return sink += h.body, true; }, s2);
           } else {
             QueryHit<3> best;
-            detail::ray_cast_all_scan(w->data(), q.origin, Vector3(q.direction.normalized()), 5,
+            detail::ray_cast_all_scan(detail::CoreAccess::data(*w), q.origin, Vector3(q.direction.normalized()), 5,
                                       [&best](const QueryHit<3>& h) {
                                         if (!best.hit() || h.distance < best.distance) best = h;
                                         return true;

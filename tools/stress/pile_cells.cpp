@@ -349,7 +349,7 @@ void Matrix::spawn_remove()
   const auto check = [&]() {
     for (std::uint32_t i = 0; i < w->body_count(); ++i) {
       if (w->id_of(i) == no_body) continue;
-      const Body<3>& b = w->data().bodies[i];
+      const Body<3>& b = detail::CoreAccess::data(*w).bodies[i];
       const double v = double(b.linear_velocity.norm());
       if (!std::isfinite(v) || !finite3(b.position.cast<double>())) ++non_finite;
       else vmax = std::max(vmax, v);
@@ -377,18 +377,18 @@ void Matrix::spawn_remove()
     if (w->step(Scalar(dt)).status != Status::ok) ++non_finite;
   check();
   std::uint32_t retired = 0;
-  for (std::uint32_t i = 0; i < w->body_count(); ++i) retired += w->data().slots.generation[i] == detail::retired_generation;
+  for (std::uint32_t i = 0; i < w->body_count(); ++i) retired += detail::CoreAccess::data(*w).slots.generation[i] == detail::retired_generation;
   std::size_t asleep = 0, n = 0;
   double overlap = 0, lowest = kInf;
   for (std::uint32_t i = 0; i < w->body_count(); ++i) {
     if (w->id_of(i) == no_body) continue;
-    const Body<3>& a = w->data().bodies[i];
+    const Body<3>& a = detail::CoreAccess::data(*w).bodies[i];
     ++n;
     asleep += a.state == MotionState::asleep;
     lowest = std::min(lowest, double(a.position.z() - a.radius) / R());
     for (std::uint32_t j = i + 1; j < w->body_count(); ++j) {
       if (w->id_of(j) == no_body) continue;
-      const Body<3>& b = w->data().bodies[j];
+      const Body<3>& b = detail::CoreAccess::data(*w).bodies[j];
       const double sum = double(a.radius) + double(b.radius);
       overlap = std::max(overlap, (sum - double((a.position - b.position).norm())) / sum);
     }
