@@ -26,7 +26,9 @@ double dist(Point2 a, Point2 b)
   return std::hypot(a.x - b.x, a.y - b.y);
 }
 
-std::string num(double v)
+// The shortest text that reads back to v, by std::to_chars (fixed or scientific, whichever is
+// shorter: what format_polygon promises; common/format.hpp's num prefers fixed).
+std::string shortest_text(double v)
 {
   char buf[64];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
@@ -35,7 +37,7 @@ std::string num(double v)
 
 std::string pt(Point2 p)
 {
-  return "(" + num(p.x) + ", " + num(p.y) + ")";
+  return "(" + shortest_text(p.x) + ", " + shortest_text(p.y) + ")";
 }
 
 [[noreturn]] void reject(const std::string& why)
@@ -281,7 +283,7 @@ std::string format_polygon(const std::vector<Point2>& vertices)
     if (!s.empty()) {
       s += ' ';
     }
-    s += num(p.x) + "," + num(p.y);
+    s += shortest_text(p.x) + "," + shortest_text(p.y);
   }
   return s;
 }
@@ -392,7 +394,7 @@ Shape2 make_shape(std::vector<Point2> v, std::string name, std::string descripti
     s.inradius_min = std::min(s.inradius_min, cross(a, b, Point2{0.0, 0.0}) / dist(a, b));
   }
   if (s.bounding_radius < 0.05 || s.bounding_radius > 20.0) {
-    reject("its size (bounding radius " + num(s.bounding_radius) +
+    reject("its size (bounding radius " + shortest_text(s.bounding_radius) +
            " m about the centroid) is outside 0.05..20 m, the range Box2D is tuned for");
   }
 

@@ -3,6 +3,7 @@
 #include "common/pi.hpp"
 
 #include "bullet/bullet.hpp"
+#include "ref3d/bullet_state.hpp"
 #include "bullet/drop_world.hpp"
 #include "common/format.hpp"
 #include "common/parallel.hpp"
@@ -31,12 +32,6 @@
 namespace statsim::tools::ref3d {
 
 namespace {
-
-btTransform to_bt(const RigidState& s)
-{
-  return btTransform(btQuaternion(s.orientation.x(), s.orientation.y(), s.orientation.z(), s.orientation.w()),
-                     bullet::to_bt(s.position));
-}
 
 std::vector<bullet::Shapes::Box> shape_boxes(const ShapeModel& m)
 {

@@ -1,6 +1,7 @@
 #include "ref3d/reference.hpp"
 
 #include "bullet/bullet.hpp"
+#include "ref3d/bullet_state.hpp"
 
 #include <cmath>
 #include <limits>
@@ -30,12 +31,6 @@ namespace {
 
 using bullet::to_bt;
 using bullet::to_eigen;
-
-btTransform to_bt(const RigidState& s)
-{
-  return btTransform(btQuaternion(s.orientation.x(), s.orientation.y(), s.orientation.z(), s.orientation.w()),
-                     to_bt(s.position));
-}
 
 }  // namespace
 
