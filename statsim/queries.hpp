@@ -188,6 +188,20 @@ Status check_query(const WorldCore<D>& world, const typename Space<D>::Vec& orig
   return Status::ok;
 }
 
+
+/// `check_query` of a ray, and its unit direction into `d`; `invalid_parameter` for a zero direction.
+template <int D>
+Status check_ray(const WorldCore<D>& world, const typename Space<D>::Vec& origin,
+                 const typename Space<D>::Vec& direction, Scalar max_distance, typename Space<D>::Vec& d)
+{
+  const Status s = check_query<D>(world, origin, direction, max_distance);
+  if (s != Status::ok) return s;
+  const Scalar len = direction.norm();
+  if (!(len > Scalar(1e-12))) return Status::invalid_parameter;
+  d = direction / len;
+  return Status::ok;
+}
+
 }  // namespace detail
 
 /// Casts a ray from `origin` (m) along `direction` (any length > 0; it is normalised) up to
@@ -203,11 +217,9 @@ Status ray_cast_all(const WorldCore<D>& world, const typename Space<D>::Vec& ori
                     QueryStats* stats = nullptr)
 {
   using Vec = typename Space<D>::Vec;
-  const Status s = detail::check_query<D>(world, origin, direction, max_distance);
+  Vec d;
+  const Status s = detail::check_ray<D>(world, origin, direction, max_distance, d);
   if (s != Status::ok) return s;
-  const Scalar len = direction.norm();
-  if (!(len > Scalar(1e-12))) return Status::invalid_parameter;
-  const Vec d = direction / len;
   const detail::WorldData<D>& w = detail::CoreAccess::data(world);
   QueryStats own;
   QueryStats& st = stats != nullptr ? *stats : own;
@@ -237,11 +249,9 @@ Status ray_cast(const WorldCore<D>& world, const typename Space<D>::Vec& origin,
                 QueryStats* stats = nullptr)
 {
   using Vec = typename Space<D>::Vec;
-  const Status s = detail::check_query<D>(world, origin, direction, max_distance);
+  Vec d;
+  const Status s = detail::check_ray<D>(world, origin, direction, max_distance, d);
   if (s != Status::ok) return s;
-  const Scalar len = direction.norm();
-  if (!(len > Scalar(1e-12))) return Status::invalid_parameter;
-  const Vec d = direction / len;
   const detail::WorldData<D>& w = detail::CoreAccess::data(world);
   QueryStats own;
   QueryStats& st = stats != nullptr ? *stats : own;
