@@ -4,8 +4,8 @@
 /// and the rest poses, as generated into `tables/NAME.hpp` by `statsim gather` / `gather2d`.
 ///
 /// Generated tables are `Signature<D, ...>` objects whose array sizes are template arguments;
-/// the world keeps a capacity-erased `SignatureView<D>` per shape (pointers and sizes), so one
-/// compiled step serves every table size.
+/// the world keeps a capacity-erased `SignatureView<D>` per shape (each array as a `Span`: its
+/// pointer and its length), so one compiled step serves every table size.
 ///
 /// Parametrisation. The tables never need an angle, only cosines and ratios, which the runtime
 /// computes with + - * / and sqrt (portable bit for bit):
@@ -61,8 +61,8 @@ inline AxisPoint locate(const AxisView& axis, Scalar x)
 /// Collision height h_coll against spin ratio (paper 3.2.1).
 struct HeightTableView {
   AxisView spin_ratio;
-  ValuesView mean;    ///< m, one per axis sample
-  ValuesView stddev;  ///< m
+  ValuesView mean;    ///< m, one per axis sample (at least `spin_ratio.size` values)
+  ValuesView stddev;  ///< m, as many
   /// Mean height at spin ratio s, linearly interpolated and clamped.
   Scalar mean_at(Scalar s) const
   {
@@ -122,7 +122,8 @@ struct CellWeight {
 
 /// Response statistics on a grid (paper 3.2.2): per cell, `components` means and
 /// `spread_per_cell` spread values (their form: `model`), cells in row-major order of the axes
-/// (the first axis varies slowest).
+/// (the first axis varies slowest). `mean` and `spread` hold at least that many values for the
+/// product of the axes' sizes.
 struct ResponseTableView {
   std::array<AxisView, max_response_axes> axes{};
   std::uint32_t axis_count = 0;
@@ -196,14 +197,14 @@ struct ResponseTableView {
 /// Rest poses (paper 3.2.3): body-frame up vectors, centre heights and frequencies.
 template <int D>
 struct RestPosesView {
-  const Scalar* normals = nullptr;      ///< D numbers per pose, unit, body frame
-  ValuesView heights;                   ///< m, centre of mass above the plane at rest
-  const Scalar* frequencies = nullptr;  ///< fraction of reference drops that ended in the pose
-  std::uint32_t count = 0;
+  Span<const Scalar> normals;      ///< D numbers per pose, unit, body frame
+  ValuesView heights;              ///< m, centre of mass above the plane at rest
+  Span<const Scalar> frequencies;  ///< fraction of reference drops that ended in the pose
+  std::uint32_t count = 0;         ///< poses: at most what each of the three arrays holds
   typename Space<D>::Vec normal(std::uint32_t i) const
   {
     typename Space<D>::Vec n;
-    for (int k = 0; k < D; ++k) n[k] = normals[i * D + k];
+    for (int k = 0; k < D; ++k) n[k] = normals.values[i * D + k];
     return n;
   }
 };
@@ -233,9 +234,9 @@ struct SignatureView {
   ResponseTableView response;  ///< components: 2D w, dv_x, dv_y; 3D w_xyz, dv_xyz
   RestPosesView<D> rest;
   /// Where the mesh the table was gathered from sits in the body frame: a mesh point m is the
-  /// body point R (m - c), R (D x D, row by row) then c (m, mesh frame); null when the table
-  /// does not record it (body frame = mesh frame).
-  const Scalar* mesh_frame = nullptr;
+  /// body point R (m - c), R (D x D, row by row) then c (m, mesh frame): D (D + 1) numbers, or
+  /// none when the table does not record it (body frame = mesh frame).
+  Span<const Scalar> mesh_frame;
   ContactView<D> contact;  ///< body-body data; absent (`present()` false) in older tables
   /// Size of the shape over the size the table was gathered at (`scaled_view`); 1 for the
   /// table's own view. Every length above already includes it; a mesh point m of the table's
@@ -249,14 +250,15 @@ struct is_quantized : std::false_type {};
 template <class T>
 struct is_quantized<T, std::void_t<decltype(std::declval<const T&>().q)>> : std::true_type {};
 
-/// The view of a table's values: a contiguous array of Scalar, or a `Quantized16`-like object.
+/// The view of a table's values: a contiguous array of Scalar, or a `Quantized16`-like object;
+/// the length is the storage's own.
 template <class Values>
 constexpr ValuesView values_view(const Values& v)
 {
   if constexpr (is_quantized<Values>::value) {
-    return ValuesView{nullptr, v.q.data(), v.scale, v.offset};
+    return ValuesView{Span<const std::int16_t>(v.q), v.scale, v.offset};
   } else {
-    return ValuesView{v.data(), nullptr, 1, 0};
+    return ValuesView{Span<const Scalar>(v)};
   }
 }
 
@@ -270,22 +272,6 @@ struct has_mesh_frame : std::false_type {};
 template <class T>
 struct has_mesh_frame<T, std::void_t<decltype(std::declval<const T&>().mesh_frame)>> : std::true_type {};
 
-template <class Values>
-constexpr std::uint32_t values_count(const Values& v)
-{
-  if constexpr (is_quantized<Values>::value) {
-    return static_cast<std::uint32_t>(v.q.size());
-  } else {
-    return static_cast<std::uint32_t>(v.size());
-  }
-}
-
-template <class Values>
-constexpr AxisView axis_view(const Values& v)
-{
-  return AxisView{v.data(), static_cast<std::uint32_t>(v.size())};
-}
-
 constexpr const char* c_str(const char* s) { return s; }
 template <class S>
 constexpr auto c_str(const S& s) -> decltype(s.c_str())
@@ -296,8 +282,8 @@ constexpr auto c_str(const S& s) -> decltype(s.c_str())
 
 /// Builds the view of any signature storage that names its parts as `BasicSignature` does
 /// (fixed-size arrays in generated tables, growable ones in host tools): every part is read
-/// through `data()` and `size()`, and response values may be Scalars or `Quantized16`-like.
-/// The one place where a view is filled.
+/// through `data()` and `size()`, which give each `Span` its length, and response values may be
+/// Scalars or `Quantized16`-like. The one place where a table's view is filled.
 template <int D, class S>
 constexpr SignatureView<D> signature_view(const S& s)
 {
@@ -310,11 +296,10 @@ constexpr SignatureView<D> signature_view(const S& s)
   v.material = s.material;
   v.restitution_threshold = s.restitution_threshold;
   v.layout = s.layout;
-  v.height.spin_ratio = detail::axis_view(s.height_axis);
+  v.height.spin_ratio = AxisView(s.height_axis);
   v.height.mean = detail::values_view(s.height_mean);
   v.height.stddev = detail::values_view(s.height_stddev);
-  v.response.axes = {{detail::axis_view(s.axis0), detail::axis_view(s.axis1), detail::axis_view(s.axis2),
-                      detail::axis_view(s.axis3)}};
+  v.response.axes = {{AxisView(s.axis0), AxisView(s.axis1), AxisView(s.axis2), AxisView(s.axis3)}};
   v.response.axis_count = s.axis_count;
   v.response.components = D == 3 ? 6u : 3u;
   v.response.model = s.model;
@@ -322,16 +307,17 @@ constexpr SignatureView<D> signature_view(const S& s)
   // gives a size no model has, which `add_shape` rejects.
   std::uint32_t cells = 1;
   for (std::uint32_t a = 0; a < s.axis_count && a < max_response_axes; ++a) cells *= v.response.axes[a].size;
-  const std::uint32_t spread_count = detail::values_count(s.response_spread);
-  v.response.spread_per_cell = cells > 0 && spread_count % cells == 0 ? spread_count / cells : 0;
   v.response.mean = detail::values_view(s.response_mean);
   v.response.spread = detail::values_view(s.response_spread);
-  v.rest.normals = s.rest_normals.data();
+  const std::uint32_t spread_count = v.response.spread.count();
+  v.response.spread_per_cell = cells > 0 && spread_count % cells == 0 ? spread_count / cells : 0;
+  v.rest.normals = Span<const Scalar>(s.rest_normals);
   v.rest.heights = detail::values_view(s.rest_heights);
-  v.rest.frequencies = s.rest_frequencies.data();
+  v.rest.frequencies = Span<const Scalar>(s.rest_frequencies);
   v.rest.count = static_cast<std::uint32_t>(s.rest_heights.size());
   if constexpr (detail::has_mesh_frame<S>::value) {
-    v.mesh_frame = s.mesh_frame.size() == std::size_t(D * (D + 1)) ? s.mesh_frame.data() : nullptr;
+    // A frame of another size (a host table's) reads as absent, as it always did.
+    if (s.mesh_frame.size() == std::size_t(D * (D + 1))) v.mesh_frame = Span<const Scalar>(s.mesh_frame);
   }
   if constexpr (detail::has_contact_data<S>::value) {
     const auto& c = s.contact;
@@ -339,14 +325,12 @@ constexpr SignatureView<D> signature_view(const S& s)
     v.contact.support = detail::values_view(c.support);
     v.contact.pair_mean = c.pair_mean.size() > 0 ? detail::values_view(c.pair_mean) : ValuesView{};
     v.contact.pair_stddev = c.pair_stddev.size() > 0 ? detail::values_view(c.pair_stddev) : ValuesView{};
-    v.contact.faces = c.faces.size() > 0 ? c.faces.data() : nullptr;
+    if (c.faces.size() > 0) v.contact.faces = Span<const Scalar>(c.faces);
     v.contact.face_count = static_cast<std::uint32_t>(c.faces.size() / face_values(D));
     for (std::size_t k = 0; k < 3; ++k) {
       v.contact.packing_mean[k] = c.packing_mean[k];
       v.contact.packing_stddev[k] = c.packing_stddev[k];
     }
-    // A support table whose size is not its S's reads as absent, which `add_shape` rejects.
-    if (detail::values_count(c.support) != v.contact.support_count()) v.contact.support = ValuesView{};
   }
   return v;
 }

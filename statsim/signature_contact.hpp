@@ -2,46 +2,88 @@
 /// @file
 /// The body-body data of a signature (table format 2.1): the view the runtime reads
 /// (`ContactView`) and the storage generated tables hold (`BasicContactData`), with the storage
-/// of table numbers both use (`ValuesView`, `AxisView`, `Quantized16`). Included by signature.hpp.
+/// of table numbers both use (`Span`, `ValuesView`, `AxisView`, `Quantized16`). Included by
+/// signature.hpp.
 
 #include "statsim/config.hpp"
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 
 namespace statsim {
 
+/// An array a view reads and its length: `size` elements of T at `values`. Every array of a
+/// view is held so, so that `add_shape` checks each count against the array it counts before it
+/// reads one element (a count that runs past its array is `Status::invalid_shape`); the length
+/// itself is the one number a view takes on trust. Made from a container (anything with `data()`
+/// and `size()`: `std::array`, `std::vector`), which gives the length, or from a pointer and a
+/// length; never from a bare pointer. Reads as the pointer it holds (`s[i]`, `s + k`, `s ==
+/// nullptr`), so code that read a table through a pointer reads it through a span alike.
+template <class T>
+struct Span {
+  T* values = nullptr;
+  std::uint32_t size = 0;  ///< elements of T at `values`
+  constexpr Span() = default;
+  constexpr Span(std::nullptr_t) {}
+  /// A length beyond 32 bits is kept as 2^32 - 1: less than the array holds, never more. (A
+  /// shift, not a comparison, which a 32-bit size_t would make always false: a warning there.)
+  constexpr Span(T* p, std::size_t n)
+      : values(p), size(std::uint64_t(n) >> 32 ? 0xffffffffu : static_cast<std::uint32_t>(n))
+  {
+  }
+  template <class U, std::enable_if_t<std::is_convertible<U*, T*>::value, int> = 0>
+  constexpr Span(const Span<U>& s) : values(s.values), size(s.size)
+  {
+  }
+  /// The whole of a container; lvalues only, as a view outlives the expression that makes it.
+  template <class C, std::enable_if_t<std::is_convertible<decltype(std::declval<C&>().data()), T*>::value, int> = 0>
+  constexpr Span(C& c) : Span(c.data(), c.size())
+  {
+  }
+  /// The whole of a built-in array.
+  template <class U, std::size_t N, std::enable_if_t<std::is_convertible<U*, T*>::value, int> = 0>
+  constexpr Span(U (&a)[N]) : Span(a, N)
+  {
+  }
+  constexpr operator T*() const { return values; }
+};
+template <class C>
+Span(C&) -> Span<std::remove_pointer_t<decltype(std::declval<C&>().data())>>;
+template <class U, std::size_t N>
+Span(U (&)[N]) -> Span<U>;
+
 /// Numbers of a table: stored as floats, value = scale * f32[i], or as 16-bit integers, value =
-/// offset + scale * q[i]. A table's own view of floats has scale 1 (x * 1 is x, bit for bit); a
-/// shape of another size (`scaled_view`) multiplies scale, and offset, by its size factor.
-/// Converts from a plain array (`const Scalar*`, scale 1) and compares equal to nullptr when it
-/// holds no values, so code that reads a table through a pointer reads it through a view alike.
+/// offset + scale * i16[i]; `count()` of them. A table's own view of floats has scale 1 (x * 1 is
+/// x, bit for bit); a shape of another size (`scaled_view`) multiplies scale, and offset, by its
+/// size factor. Compares equal to nullptr when it holds no values.
 struct ValuesView {
-  const Scalar* f32 = nullptr;
-  const std::int16_t* i16 = nullptr;
+  Span<const Scalar> f32;
+  Span<const std::int16_t> i16;
   Scalar scale = 1;
   Scalar offset = 0;
   constexpr ValuesView() = default;
-  constexpr ValuesView(const Scalar* f, const std::int16_t* q = nullptr, Scalar s = 1, Scalar o = 0)
-      : f32(f), i16(q), scale(s), offset(o)
-  {
-  }
+  constexpr ValuesView(std::nullptr_t) {}
+  /// Floats, read as they are (scale 1).
+  constexpr ValuesView(Span<const Scalar> f) : f32(f) {}
+  /// 16-bit integers q, read as offset + scale * q.
+  constexpr ValuesView(Span<const std::int16_t> q, Scalar s, Scalar o) : i16(q), scale(s), offset(o) {}
+  /// Values that can be read: the length of the storage in use (floats when there are any).
+  constexpr std::uint32_t count() const { return f32.values ? f32.size : i16.size; }
   /// Value i (any integer index, as a pointer takes).
   template <class Index>
   Scalar operator[](Index i) const
   {
-    return f32 ? f32[i] * scale : offset + scale * Scalar(i16[i]);
+    return f32.values ? f32.values[i] * scale : offset + scale * Scalar(i16.values[i]);
   }
-  friend constexpr bool operator==(const ValuesView& v, std::nullptr_t) { return !v.f32 && !v.i16; }
-  friend constexpr bool operator!=(const ValuesView& v, std::nullptr_t) { return v.f32 || v.i16; }
+  friend constexpr bool operator==(const ValuesView& v, std::nullptr_t) { return !v.f32.values && !v.i16.values; }
+  friend constexpr bool operator!=(const ValuesView& v, std::nullptr_t) { return v.f32.values || v.i16.values; }
 };
 
 /// A sampled axis: `size` strictly increasing values.
-struct AxisView {
-  const Scalar* values = nullptr;
-  std::uint32_t size = 0;
-};
+using AxisView = Span<const Scalar>;
 
 /// 16-bit storage of N table values: value = offset + scale * Scalar(q[i]).
 template <std::size_t N>
@@ -82,17 +124,18 @@ constexpr std::uint32_t max_contact_faces = 32;
 template <int D>
 struct ContactView {
   std::uint32_t support_size = 0;  ///< S, >= 2; 0: no body-body data
-  ValuesView support;              ///< m, 6 S^2 values (2D: 4 S)
-  ValuesView pair_mean;    ///< m, one per h_coll axis sample
-  ValuesView pair_stddev;  ///< m
-  /// `face_values(D)` numbers per face: unit normal, offset (m, times `offset_scale`), packing ratio
-  const Scalar* faces = nullptr;
+  ValuesView support;              ///< m, exactly `support_count()` values: 6 S^2 (2D: 4 S)
+  ValuesView pair_mean;    ///< m, one per h_coll axis sample (at least); or none
+  ValuesView pair_stddev;  ///< m, as many
+  /// `face_values(D)` numbers per face: unit normal, offset (m, times `offset_scale`), packing
+  /// ratio; at least `face_count` faces
+  Span<const Scalar> faces;
   std::uint32_t face_count = 0;
   /// Factor on the stored face offsets: 1 for the table's own size, its size factor for a
   /// shape of another size (`scaled_view`).
   Scalar offset_scale = 1;
   /// Offset of face i, m.
-  Scalar face_offset(std::uint32_t i) const { return faces[i * face_values(D) + D] * offset_scale; }
+  Scalar face_offset(std::uint32_t i) const { return faces.values[i * face_values(D) + D] * offset_scale; }
   std::array<Scalar, 3> packing_mean{};    ///< ratio, by angle of the line of centres
   std::array<Scalar, 3> packing_stddev{};  ///< ratio
   bool present() const { return support_size >= 2; }

@@ -92,8 +92,8 @@ TEST_CASE("add_shape reads 16-bit height tables and rejects them when missing")
   static const std::int16_t mean_q[3] = {-100, 0, 100};
   static const std::int16_t stddev_q[3] = {10, 20, 30};
   SignatureView<2> valid = f32;
-  valid.height.mean = ValuesView{nullptr, mean_q, 0.001f, 0.66f};
-  valid.height.stddev = ValuesView{nullptr, stddev_q, 0.001f, 0.0f};
+  valid.height.mean = ValuesView{Span<const std::int16_t>(mean_q), 0.001f, 0.66f};
+  valid.height.stddev = ValuesView{Span<const std::int16_t>(stddev_q), 0.001f, 0.0f};
   World2<4> w;
   expect_all_rejected<2>(w, valid, missing_pointers<2>(valid));
 }
@@ -105,10 +105,10 @@ TEST_CASE("add_shape rejects rest frequencies that are not finite or outside [0,
   for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -0.25f,
                           1.5f}) {
     CAPTURE(bad);
-    std::vector<Scalar> freq(valid.rest.frequencies, valid.rest.frequencies + n);
+    std::vector<Scalar> freq(valid.rest.frequencies.values, valid.rest.frequencies.values + n);
     freq[n - 1] = bad;
     SignatureView<3> v = valid;
-    v.rest.frequencies = freq.data();
+    v.rest.frequencies = freq;
     World3<4> w;
     CHECK(w.add_shape(v).status == Status::invalid_shape);
     CHECK(w.shape_count() == 0);
@@ -145,10 +145,10 @@ TEST_CASE("add_shape rejects response-model data that does not fit its model, wi
   // A value that is not finite in the spread of either new model.
   for (const SignatureView<3>* valid : {&correlated, &empirical}) {
     const std::uint32_t n = 8 * valid->response.spread_per_cell;
-    std::vector<Scalar> spread(valid->response.spread.f32, valid->response.spread.f32 + n);
+    std::vector<Scalar> spread(valid->response.spread.f32.values, valid->response.spread.f32.values + n);
     spread[n / 2] = std::numeric_limits<Scalar>::quiet_NaN();
     SignatureView<3> v = *valid;
-    v.response.spread.f32 = spread.data();
+    v.response.spread = ValuesView(spread);
     World3<4> w2;
     CHECK(w2.add_shape(v).status == Status::invalid_shape);
     CHECK(w2.shape_count() == 0);

@@ -100,10 +100,10 @@ TEST_CASE("state_hash differs for worlds that differ in any parameter, material 
     CHECK(scene_hash(def, ball, other, steps) != base);
     static constexpr auto cube16 = quantize16(testing::cube_synthetic);
     CHECK(scene_hash(def, ball, cube16.view(), steps) != base);  // the same tables, rounded
-    std::vector<Scalar> freq(sig.rest.frequencies, sig.rest.frequencies + sig.rest.count);
+    std::vector<Scalar> freq(sig.rest.frequencies.values, sig.rest.frequencies.values + sig.rest.count);
     freq[0] = 0.5f;
     other = sig;
-    other.rest.frequencies = freq.data();
+    other.rest.frequencies = freq;
     CHECK(scene_hash(def, ball, other, steps) != base);
   }
 }

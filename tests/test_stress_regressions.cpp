@@ -54,11 +54,11 @@ struct BunnyCopy {
     response_mean.assign(t.response_mean.begin(), t.response_mean.end());
     rest_normals.assign(t.rest_normals.begin(), t.rest_normals.end());
     rest_heights.assign(t.rest_heights.begin(), t.rest_heights.end());
-    view.height.spin_ratio.values = height_axis.data();
-    view.height.mean.f32 = height_mean.data();
-    view.response.mean.f32 = response_mean.data();
-    view.rest.normals = rest_normals.data();
-    view.rest.heights = rest_heights.data();
+    view.height.spin_ratio = height_axis;
+    view.height.mean = ValuesView(height_mean);
+    view.response.mean = ValuesView(response_mean);
+    view.rest.normals = rest_normals;
+    view.rest.heights = ValuesView(rest_heights);
   }
 };
 }  // namespace

@@ -74,13 +74,17 @@ inline bool readable(const ValuesView& v) { return v.f32 != nullptr || v.i16 != 
 /// True when an axis has a sample and its values can be read.
 inline bool readable(const AxisView& a) { return a.values != nullptr && a.size >= 1; }
 
-/// The layout of a signature: every pointer the world will read is present, for every count
-/// above 0, and the counts fit the runtime. The values are checked by `check_signature_values`.
+/// The layout of a signature: every array the world will read is present, for every count
+/// above 0, the counts fit the runtime, and each count fits the length of the arrays it counts,
+/// so that no check and no step reads past an array of a view built by hand. The values are
+/// checked by `check_signature_values`, which reads only what this one has measured.
 template <int D>
 Status check_signature_layout(const SignatureView<D>& sig)
 {
   const HeightTableView& h = sig.height;
   if (!readable(h.spin_ratio) || !readable(h.mean) || !readable(h.stddev)) return Status::invalid_shape;
+  const std::uint32_t heights = h.spin_ratio.size;
+  if (h.mean.count() < heights || h.stddev.count() < heights) return Status::invalid_shape;
   const ResponseTableView& r = sig.response;
   const std::uint32_t expected_axes = (D == 3 ? 3u : 2u) + (sig.layout == ResponseLayout::with_speed ? 1u : 0u);
   if (r.axis_count != expected_axes || r.components != (D == 3 ? 6u : 3u)) return Status::invalid_shape;
@@ -98,22 +102,33 @@ Status check_signature_layout(const SignatureView<D>& sig)
     default: return Status::invalid_shape;
   }
   // Cells times values per cell must fit the 32-bit offsets of `ResponseTableView::lookup`.
-  std::uint64_t values = r.components > s ? r.components : s;
+  std::uint64_t values = r.components > s ? r.components : s, cells = 1;
   for (std::uint32_t a = 0; a < r.axis_count; ++a) {
     if (!readable(r.axes[a])) return Status::invalid_shape;
     values *= r.axes[a].size;
+    cells *= r.axes[a].size;
     if (values > 0x7fffffffu) return Status::invalid_shape;
   }
   if (!readable(r.mean) || !readable(r.spread)) return Status::invalid_shape;
+  if (r.mean.count() < cells * r.components || r.spread.count() < cells * s) return Status::invalid_shape;
   const RestPosesView<D>& rest = sig.rest;
   if (rest.count > max_rest_poses) return Status::invalid_shape;
   if (rest.count > 0 && (rest.normals == nullptr || rest.heights == nullptr || rest.frequencies == nullptr))
     return Status::invalid_shape;
+  if (rest.normals.size / D < rest.count || rest.heights.count() < rest.count || rest.frequencies.size < rest.count)
+    return Status::invalid_shape;
+  // Read by `mesh_to_world` only, but it is a count too (D (D + 1) numbers).
+  if (sig.mesh_frame != nullptr && sig.mesh_frame.size < std::uint32_t(D * (D + 1))) return Status::invalid_shape;
   const ContactView<D>& c = sig.contact;
   if (c.support_size == 0) return Status::ok;
   if (c.support_size < 2 || c.support_size > max_support_size || !readable(c.support)) return Status::invalid_shape;
+  // The map's layout follows from S, so its length is exactly S's: any other is the wrong S.
+  if (c.support.count() != c.support_count()) return Status::invalid_shape;
   if ((c.pair_mean == nullptr) != (c.pair_stddev == nullptr)) return Status::invalid_shape;
+  if (c.pair_mean != nullptr && (c.pair_mean.count() < heights || c.pair_stddev.count() < heights))
+    return Status::invalid_shape;
   if (c.face_count > max_contact_faces || (c.face_count > 0 && c.faces == nullptr)) return Status::invalid_shape;
+  if (c.faces.size / face_values(D) < c.face_count) return Status::invalid_shape;
   return Status::ok;
 }
 
@@ -179,7 +194,7 @@ Status check_signature_values(const SignatureView<D>& sig)
       if (!(c.pair_mean[i] > 0 && c.pair_mean[i] <= reach) || bad(c.pair_stddev[i]) || c.pair_stddev[i] < 0)
         return Status::invalid_shape;
   for (std::uint32_t k = 0; k < c.face_count; ++k) {
-    const Scalar* f = c.faces + k * face_values(D);
+    const Scalar* f = c.faces.values + k * face_values(D);
     Scalar n2 = 0;
     for (int d = 0; d < D; ++d) n2 += f[d] * f[d];
     if (!(std::fabs(n2 - 1) < Scalar(2e-3)) || !(std::fabs(c.face_offset(k)) <= sig.bounding_radius))

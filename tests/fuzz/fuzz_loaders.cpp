@@ -69,8 +69,8 @@ void fuzz_signature(Input& in)
     t.height_stddev.push_back(in.value(0.2f));
   }
   v.height.spin_ratio = AxisView{nh ? t.height_axis.data() : nullptr, nh};
-  v.height.mean.f32 = nh ? t.height_mean.data() : nullptr;
-  v.height.stddev.f32 = nh ? t.height_stddev.data() : nullptr;
+  v.height.mean = ValuesView(t.height_mean);
+  v.height.stddev = ValuesView(t.height_stddev);
   v.response.axis_count = in.below(max_response_axes + 1);
   v.response.components = in.below(8) ? components : in.below(8);
   std::uint32_t cells = 1;
@@ -98,11 +98,11 @@ void fuzz_signature(Input& in)
     else t.stddev.push_back(in.value(1));
   }
   if (q16) {
-    v.response.mean = ValuesView{nullptr, values ? t.mean16.data() : nullptr, in.value(0.01f), in.value(1)};
-    v.response.spread = ValuesView{nullptr, spreads ? t.stddev16.data() : nullptr, in.value(0.01f), in.value(1)};
+    v.response.mean = ValuesView{Span<const std::int16_t>(t.mean16), in.value(0.01f), in.value(1)};
+    v.response.spread = ValuesView{Span<const std::int16_t>(t.stddev16), in.value(0.01f), in.value(1)};
   } else {
-    v.response.mean.f32 = values ? t.mean.data() : nullptr;
-    v.response.spread.f32 = spreads ? t.stddev.data() : nullptr;
+    v.response.mean = ValuesView(t.mean);
+    v.response.spread = ValuesView(t.stddev);
   }
   const std::uint32_t nr = in.below(4);
   for (std::uint32_t i = 0; i < nr; ++i) {
@@ -111,9 +111,9 @@ void fuzz_signature(Input& in)
     t.frequencies.push_back(in.value(1));
   }
   v.rest.count = nr;
-  v.rest.normals = nr ? t.normals.data() : nullptr;
-  v.rest.heights = nr ? t.heights.data() : nullptr;
-  v.rest.frequencies = nr ? t.frequencies.data() : nullptr;
+  v.rest.normals = t.normals;
+  v.rest.heights = ValuesView(t.heights);
+  v.rest.frequencies = t.frequencies;
   const bool ordinary = !in.special();
 
   World<D, 8, 2, 32, 2> world;

@@ -106,11 +106,11 @@ Candidate response_error_with(const DenseTable& d, const std::vector<std::vector
   if (i16) {
     qm = quantize(mean_f);
     qs = quantize(std_f);
-    view.mean = ValuesView{nullptr, qm.q.data(), qm.scale, qm.offset};
-    view.spread = ValuesView{nullptr, qs.q.data(), qs.scale, qs.offset};
+    view.mean = ValuesView{Span<const std::int16_t>(qm.q), qm.scale, qm.offset};
+    view.spread = ValuesView{Span<const std::int16_t>(qs.q), qs.scale, qs.offset};
   } else {
-    view.mean.f32 = mean_f.data();
-    view.spread.f32 = std_f.data();
+    view.mean = ValuesView(mean_f);
+    view.spread = ValuesView(std_f);
   }
 
   Candidate out;
@@ -274,7 +274,7 @@ HeightCandidate height_error(const DenseTable& d, const std::vector<std::size_t>
   const std::vector<float> axis = as_float(pick(d.height_axis, keep)), mean = as_float(pick(d.height_mean, keep));
   HeightTableView view;
   view.spin_ratio = AxisView{axis.data(), static_cast<std::uint32_t>(axis.size())};
-  view.mean.f32 = mean.data();
+  view.mean = ValuesView(mean);
   HeightCandidate out;
   out.keep = keep;
   std::vector<char> is_kept(d.height_axis.size(), 0);
