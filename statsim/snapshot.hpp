@@ -26,6 +26,7 @@
 /// and the contact flags' bookkeeping (a body whose flags are set and that is not awake is
 /// marked for the next step to clear, as the last step's touching pairs would have).
 
+#include "statsim/detail/feature_checks.hpp"
 #include "statsim/detail/slope.hpp"
 #include "statsim/detail/snapshot_format.hpp"
 #include "statsim/world.hpp"
@@ -274,8 +275,7 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
   const Status def_status = check_world_def(def);
   if (def_status != Status::ok) return def_status;
   if (def.broad_phase == BroadPhase::grid && !w.grid_storage) return Status::invalid_parameter;
-  if (def.body_contacts == BodyContacts::hulls && !includes(w.features, Features::hull_contacts))
-    return Status::not_compiled;
+  if (check_def_features(w.features, def) != Status::ok) return Status::not_compiled;
   // The widest diameter is that of some shape added (`add_body`), or 0 before any body.
   bool widest_known = widest == 0 && bodies == 0;
   for (std::uint32_t i = 0; i < shapes; ++i) {
@@ -306,8 +306,7 @@ Status read_snapshot(WorldData<D>& w, const unsigned char* data, std::size_t siz
     if (!finite(p.normal) || !finite(p.offset) || !(std::fabs(p.normal.squaredNorm() - 1) < Scalar(2e-3)))
       return Status::invalid_plane;
     if (!within(p.offset, limits::coordinate)) return Status::out_of_range;
-    Scalar gn;
-    if (!includes(w.features, Features::slopes) && is_tilted_plane(def.gravity, p.normal, gn)) return Status::not_compiled;
+    if (check_plane_features(w.features, def.gravity, p.normal) != Status::ok) return Status::not_compiled;
     if (commit) w.planes[i] = p;
   }
   if (commit) w.tilted_planes = any_tilted_plane(w);

@@ -114,7 +114,7 @@ class WorldCore {
   /// poses: add shapes while setting up, not during steps.
   Added<ShapeId> add_shape(const SignatureView<D>& sig)
   {
-    if (detail::check_statistical(w_) != Status::ok) return {Status::not_compiled, ShapeId{}};
+    if (!includes(w_.features, Features::statistical)) return {Status::not_compiled, ShapeId{}};
     const Status s = detail::check_signature(sig);
     if (s != Status::ok) return {s, ShapeId{}};
     if (w_.shape_count == w_.max_shapes) return {Status::capacity_exceeded, ShapeId{}};
@@ -145,8 +145,7 @@ class WorldCore {
     const Scalar len = normal.norm();
     if (!(len > Scalar(1e-12)) || !detail::finite(len)) return {Status::invalid_plane, 0};
     if (w_.plane_count == w_.max_planes) return {Status::capacity_exceeded, 0};
-    Scalar gn;
-    if (!includes(w_.features, Features::slopes) && detail::is_tilted_plane(w_.def.gravity, Vec(normal / len), gn))
+    if (detail::check_plane_features(w_.features, w_.def.gravity, Vec(normal / len)) != Status::ok)
       return {Status::not_compiled, 0};
     w_.planes[w_.plane_count] = Plane<D>{normal / len, offset};
     ++w_.plane_count;

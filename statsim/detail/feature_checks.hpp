@@ -15,28 +15,33 @@
 namespace statsim {
 namespace detail {
 
-/// `not_compiled` when the parameters `def` need a feature the world `w` lacks: hull contacts
-/// without `Features::hull_contacts`; without `Features::slopes`, a gravity that tilts one of
-/// its planes (`is_tilted_plane`); else `ok`.
+/// `not_compiled` when a plane of unit normal `n` is tilted under gravity `g` (`is_tilted_plane`)
+/// in a world of features `f` without `Features::slopes`, else `ok`.
+template <class Vec>
+Status check_plane_features(Features f, const Vec& g, const Vec& n)
+{
+  Scalar gn;
+  return !includes(f, Features::slopes) && is_tilted_plane(g, n, gn) ? Status::not_compiled : Status::ok;
+}
+
+/// `not_compiled` when parameters `def` ask for hull contacts of a world of features `f` without
+/// `Features::hull_contacts`, else `ok`.
+template <int D>
+Status check_def_features(Features f, const WorldDef<D>& def)
+{
+  return def.body_contacts == BodyContacts::hulls && !includes(f, Features::hull_contacts) ? Status::not_compiled
+                                                                                           : Status::ok;
+}
+
+/// `not_compiled` when the parameters `def` need a feature the world `w` lacks: hull contacts, or
+/// a gravity that tilts one of its planes; else `ok`.
 template <int D>
 Status check_features(const WorldData<D>& w, const WorldDef<D>& def)
 {
-  if (def.body_contacts == BodyContacts::hulls && !includes(w.features, Features::hull_contacts))
-    return Status::not_compiled;
-  if (!includes(w.features, Features::slopes)) {
-    Scalar gn;
-    for (std::uint32_t p = 0; p < w.plane_count; ++p)
-      if (is_tilted_plane(def.gravity, w.planes[p].normal, gn)) return Status::not_compiled;
-  }
-  return Status::ok;
-}
-
-/// `not_compiled` when a world `w` without `Features::statistical` would get a statistical
-/// shape, else `ok`.
-template <int D>
-Status check_statistical(const WorldData<D>& w)
-{
-  return includes(w.features, Features::statistical) ? Status::ok : Status::not_compiled;
+  Status s = check_def_features(w.features, def);
+  for (std::uint32_t p = 0; p < w.plane_count && s == Status::ok; ++p)
+    s = check_plane_features(w.features, def.gravity, w.planes[p].normal);
+  return s;
 }
 
 }  // namespace detail
