@@ -1,6 +1,7 @@
 // tools/fidelity: the distances of `statsim fidelity`, the JSON signature loader and a tiny
 // end-to-end run of the command.
 #include "common/commands.hpp"
+#include "fidelity/convergence.hpp"
 #include "fidelity/fidelity.hpp"
 #include "fidelity/metrics.hpp"
 #include "ref3d/ref3d.hpp"
@@ -551,4 +552,141 @@ TEST_CASE("fidelity: bad options fail before any run")
   CHECK(run_cli({"--shape", "box", "--reference", "nonsense", "--quiet"}) != 0);
   CHECK(run_cli({"--mesh", "tools/meshes/box.obj", "--quiet"}) != 0);  // needs --table
   CHECK(!fs::exists(json_path));
+}
+
+TEST_CASE("fidelity convergence: a change within its floor converges, one past it does not")
+{
+  // Two figures over four seeds at three levels. Level 0 to 1: the first figure moves by 1.0 where
+  // its standard deviation is 0.1 (floor 1.645 sqrt(2 x 0.01 / 4) = 0.116): past the floor. Level 1
+  // to 2: both move by less than their floors.
+  ConvergenceScene sc;
+  sc.metrics = {{"a", "", false}, {"b", "m", true}};
+  ConvergenceLevel l0, l1, l2;
+  const double spread[4] = {-0.1, 0.1, -0.1, 0.1};  // standard deviation 0.1155
+  for (double e : spread) {
+    l0.values.push_back({1.0 + e, 5.0 + e});
+    l1.values.push_back({2.0 + e, 5.0 + e});
+    l2.values.push_back({2.05 + e, 4.99 + e});
+  }
+  sc.levels = {l0, l1, l2};
+  compare_levels(sc);
+  REQUIRE(sc.changes.size() == 2);
+  const double sd = std::sqrt(4 * 0.01 / 3.0);
+  const double floor = 1.6448536269514722 * std::sqrt(2 * sd * sd / 4);
+  CHECK(sc.changes[0][0].change == doctest::Approx(1.0));
+  CHECK(sc.changes[0][0].floor == doctest::Approx(floor));
+  CHECK(sc.changes[0][1].change == doctest::Approx(0.0));
+  CHECK(sc.changes[1][0].change == doctest::Approx(0.05));
+  CHECK(sc.changes[1][1].change == doctest::Approx(-0.01));
+  CHECK(sc.converged == 1);
+  // Levels that agree from the start converge at the first.
+  sc.levels = {l1, l2};
+  compare_levels(sc);
+  CHECK(sc.converged == 0);
+  // Moving past the floor at every refinement: no level converges.
+  sc.levels = {l0, l1};
+  compare_levels(sc);
+  CHECK(sc.converged == -1);
+  // Just past the floor (0.15 against 0.116) is past it.
+  ConvergenceLevel l3 = l2;
+  for (std::vector<double>& v : l3.values) v[0] += 0.15;
+  sc.levels = {l2, l3};
+  compare_levels(sc);
+  CHECK(sc.changes[0][0].change > sc.changes[0][0].floor);
+  CHECK(sc.converged == -1);
+  // Two refinements of 0.1 each stay within the floor, their sum does not: the coarsest level
+  // that holds is the middle one.
+  ConvergenceLevel m1 = l2, m2 = l2;
+  for (std::vector<double>& v : m1.values) v[0] += 0.1;
+  for (std::vector<double>& v : m2.values) v[0] += 0.2;
+  sc.levels = {l2, m1, m2};
+  compare_levels(sc);
+  CHECK(std::fabs(sc.changes[0][0].change) <= sc.changes[0][0].floor);
+  CHECK(std::fabs(sc.changes[1][0].change) <= sc.changes[1][0].floor);
+  CHECK(std::fabs(sc.to_finest[0][0].change) > sc.to_finest[0][0].floor);
+  CHECK(sc.converged == 1);
+}
+
+TEST_CASE("fidelity convergence: a figure the same for every seed is held to its resolution")
+{
+  // A stack: every seed gives the same value, so the statistical floor is zero.
+  ConvergenceScene sc;
+  sc.metrics = {{"held", "", false}};
+  ConvergenceLevel a, b, c;
+  for (int i = 0; i < 5; ++i) {
+    a.values.push_back({0.990});
+    b.values.push_back({0.9985});
+    c.values.push_back({0.9995});
+  }
+  sc.levels = {a, b, c};
+  compare_levels(sc);
+  CHECK(convergence_resolution(sc.metrics[0]) == doctest::Approx(0.002));
+  CHECK(sc.changes[0][0].floor == doctest::Approx(0.002));
+  CHECK(sc.converged == 1);  // 0.0085 is past the resolution, 0.001 is not
+}
+
+TEST_CASE("fidelity convergence: a heap of 20 at two steps reports each figure's change and floor")
+{
+  TempDir dir("fidelity_convergence");
+  const std::string json_path = dir.file("conv.json");
+  REQUIRE(run_cli({"--shape", "box", "--scenes", "heap", "--scenes-only", "--heap-count", "20", "--scene-seeds", "3",
+                   "--pile-reference-dt", "1/120", "--convergence", "step", "--refinements", "1", "--time-limit", "2",
+                   "--threads", "2", "--json", json_path, "--quiet"}) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read_file(json_path));
+  CHECK(j.at("convergence") == "step");
+  REQUIRE(j.at("scenes").size() == 1);
+  const nlohmann::json& heap = j.at("scenes")[0];
+  CHECK(heap.at("kind") == "heap");
+  const nlohmann::json& levels = heap.at("levels");
+  REQUIRE(levels.size() == 2);
+  CHECK(levels[0].at("dt").get<double>() == doctest::Approx(1.0 / 120));
+  CHECK(levels[1].at("dt").get<double>() == doctest::Approx(1.0 / 240));
+  CHECK(levels[0].at("iterations") == 10);
+  REQUIRE(levels[0].at("values").size() == 3);  // one row per seed
+  const std::size_t figures = heap.at("metrics").size();
+  REQUIRE(figures == 2);  // angle of repose and height
+  REQUIRE(levels[0].at("change_to_next").size() == figures);
+  REQUIRE(levels[0].at("floor").size() == figures);
+  for (std::size_t m = 0; m < figures; ++m) {
+    const double change = levels[0].at("change_to_next")[m];
+    const double floor = levels[0].at("floor")[m];
+    CHECK(std::isfinite(change));
+    CHECK(floor > 0);  // three seeds of a poured heap are not all alike
+    const double mean0 = levels[0].at("means")[m], mean1 = levels[1].at("means")[m];
+    CHECK(change == doctest::Approx(mean1 - mean0));
+  }
+  CHECK_FALSE(levels[1].contains("change_to_next"));
+  const int converged = heap.at("converged_level");
+  CHECK(converged >= -1);
+  CHECK(converged <= 0);
+  CHECK(levels[0].at("cpu_seconds").get<double>() > 0);
+  // Read back, the run compares the same way.
+  const ConvergenceResult back = convergence_from_json(read_file(json_path));
+  REQUIRE(back.scenes.size() == 1);
+  CHECK(back.scenes[0].converged == converged);
+  REQUIRE(back.scenes[0].changes.size() == 1);
+  for (std::size_t m = 0; m < figures; ++m) {
+    CHECK(back.scenes[0].changes[0][m].change == levels[0].at("change_to_next")[m].get<double>());
+    CHECK(back.scenes[0].changes[0][m].floor == levels[0].at("floor")[m].get<double>());
+  }
+  CHECK(convergence_table(back).find("heap (3 seeds)") != std::string::npos);
+  CHECK_THROWS_AS(convergence_from_json("{}"), std::runtime_error);
+}
+
+TEST_CASE("fidelity: statistical-spheres is the library's default body-body model beside the bench's hull contacts")
+{
+  TempDir dir("fidelity_spheres");
+  const std::string json_path = dir.file("column.json");
+  REQUIRE(run_cli({"--shape", "box", "--scenes", "column", "--scenes-only", "--methods",
+                   "statistical,statistical-spheres", "--column-height", "3", "--stack-time", "0.5", "--scene-seeds",
+                   "2", "--threads", "2", "--json", json_path, "--quiet"}) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read_file(json_path));
+  const nlohmann::json& methods = j.at("scenes").at("column").at("methods");
+  REQUIRE(methods.contains("statistical"));
+  REQUIRE(methods.contains("statistical-spheres"));
+  // Collision spheres keep the cubes a sphere's diameter apart, hull contacts face to face.
+  const double hulls = methods.at("statistical").at("means").at("held");
+  const double spheres = methods.at("statistical-spheres").at("means").at("held");
+  CHECK(hulls < 1.02);
+  CHECK(spheres > hulls + 0.05);
 }

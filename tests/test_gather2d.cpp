@@ -425,7 +425,34 @@ TEST_CASE("compare2d: a small drop runs in both simulations and gives finite dis
     CHECK(m->neighbour_median > 0.95);
     CHECK(m->neighbour_median < 3.0);
   }
-  CHECK(csv.find(",rest_tvd_single,neighbour_median\n") != std::string::npos);
+  CHECK(csv.find(",rest_tvd_single,neighbour_median,pile_height_sd\n") != std::string::npos);
+}
+
+TEST_CASE("compare2d: Box2D's substeps refine the reference alone, and the pile height's spread is over the drops")
+{
+  Compare2dOptions o = compare_options(2);
+  o.n = 12;
+  o.steps = 150;
+  const Compare2dResult one = run_compare2d(o);
+  o.box2d_substeps = 2;
+  const Compare2dResult two = run_compare2d(o);
+  // statsim steps dt either way: the same final states.
+  REQUIRE(one.statsim.final.size() == two.statsim.final.size());
+  for (std::size_t i = 0; i < one.statsim.final.size(); ++i) {
+    CHECK(one.statsim.final[i].x == two.statsim.final[i].x);
+    CHECK(one.statsim.final[i].y == two.statsim.final[i].y);
+  }
+  // Box2D at half the step ends elsewhere.
+  bool moved = false;
+  for (std::size_t i = 0; i < one.box2d.final.size(); ++i)
+    moved = moved || one.box2d.final[i].x != two.box2d.final[i].x || one.box2d.final[i].y != two.box2d.final[i].y;
+  CHECK(moved);
+  // Two drops: the standard deviation of two values is |a - b| / sqrt(2), and it is not zero for
+  // two different piles.
+  CHECK(one.box2d.pile_height_sd > 0.0);
+  CHECK(std::isfinite(one.box2d.pile_height_sd));
+  o.box2d_substeps = 0;
+  CHECK_THROWS_AS(run_compare2d(o), std::invalid_argument);
 }
 
 TEST_CASE("compare2d: the frame files hold the first drop's final states of both engines")

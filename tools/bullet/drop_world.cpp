@@ -188,6 +188,7 @@ DropWorld::DropWorld(const std::vector<DropBody>& bodies, const std::vector<int>
   m.world->setGravity(to_bt(settings.gravity));
   if (!settings.update_all_aabbs) m.world->setForceUpdateAllAabbs(false);
   m.world->getSolverInfo().m_restitutionVelocityThreshold = settings.restitution_threshold;
+  m.world->getSolverInfo().m_numIterations = settings.solver_iterations;
   gDeactivationTime = settings.sleep_time;
 
   const double friction = std::sqrt(settings.friction);

@@ -87,6 +87,7 @@ struct DropSettings {
   double sleep_time = 0.5;
   bool sleeping = true;           ///< false: bodies never deactivate
   bool update_all_aabbs = true;   ///< false: AABBs of static and sleeping objects are not recomputed
+  int solver_iterations = 10;     ///< iterations of the sequential impulse solver per step (Bullet's default)
 };
 
 /// The dropped body: its collision shape (from Shapes) and mass properties in the body frame.

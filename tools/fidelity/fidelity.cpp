@@ -18,7 +18,8 @@
 // by the same code.
 //
 // Rest configurations are those of the shape's compiled table (with --mesh: of the first --table,
-// which the methods statistical, statistical-norest and statistical-independent then use).
+// which the methods statistical, statistical-norest, statistical-independent and statistical-spheres
+// then use).
 // Single drops (--runs N per sample). Run r draws its initial state from its own splitmix64
 // stream seeded with mix(seed, r) (reference sample B: r + 1,000,000): orientation uniform on
 // SO(3) (a uniform point of the unit 4-ball by rejection, normalised); angular velocity
@@ -187,6 +188,7 @@ FidelityResult run_fidelity(const FidelityOptions& options)
   ref.description = "Bullet full";
   MethodSpec pile_ref = ref;
   pile_ref.gather_reference = false;
+  pile_ref.solver_iterations = options.pile_reference_iterations;
   const std::string which = gather_ref ? "Bullet full, statsim gather's settings" : "Bullet full, statsim bench's settings";
   res.reference.name = "reference";
   res.reference.description = which + ", sample A";

@@ -36,6 +36,15 @@ struct FidelityOptions {
   int pile_seeds = 20;               ///< piles: scene seeds 1..N (reference floor: N+1..2N)
   int pile_count = 50;               ///< bodies per pile
   double pile_reference_dt = 1.0 / 240.0;  ///< s
+  /// Iterations of the piles' and scenes' reference solver per step (statsim bench's Bullet
+  /// settings otherwise; Bullet's default is 10).
+  int pile_reference_iterations = 10;
+  /// "step" or "iterations": instead of comparing methods, run only the piles' and scenes'
+  /// reference at `refinements` + 1 levels, the step halved (or the iterations doubled) from one
+  /// level to the next, and report how far each figure moves (tools/fidelity/convergence.hpp).
+  /// Empty: the normal run.
+  std::string convergence;
+  int refinements = 2;               ///< levels after the first of a convergence run
   int bench_n = 100;                 ///< bodies of the step-time scene
   int bench_steps = 300;             ///< steps of the step-time scene
   bool timing = true;                ///< measure step_ms

@@ -1,6 +1,7 @@
 // Output of `statsim fidelity`: the table on stdout, the JSON, the charts, and the command.
 #include "fidelity/fidelity.hpp"
 #include "common/commands.hpp"
+#include "fidelity/convergence.hpp"
 
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
@@ -11,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
@@ -189,6 +191,8 @@ std::string command_line(const FidelityOptions& o)
   if (o.piles || !o.scenes.empty())
     c << " --pile-seeds " << o.pile_seeds << " --pile-count " << o.pile_count << " --pile-reference-dt "
       << o.pile_reference_dt;
+  if (o.pile_reference_iterations != 10) c << " --pile-reference-iterations " << o.pile_reference_iterations;
+  if (!o.convergence.empty()) c << " --convergence " << o.convergence << " --refinements " << o.refinements;
   if (!o.piles) c << " --no-piles";
   if (o.timing) c << " --bench-n " << o.bench_n << " --bench-steps " << o.bench_steps;
   else c << " --no-timing";
@@ -470,7 +474,9 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--methods", *method_list,
                   "comma-separated: full, full-gather (Bullet full with the gathering's settings at --dt: the "
                   "reference's engine at the methods' step), low, hull, spheres7, sphere, statistical, "
-                  "statistical-norest, statistical-independent, statistical:NAME (default: "
+                  "statistical-norest, statistical-independent, statistical-spheres (collision spheres between bodies, the "
+                  "library's default; the others take hull contacts where the table has body-body data), "
+                  "statistical:NAME (default: "
                   "full,low,spheres7,sphere,statistical,statistical-norest,statistical-independent)");
   cmd->add_option("--runs", opts->runs, "single drops per sample")->capture_default_str();
   cmd->add_option("--dt", *dt_text, "step of the methods, s (a number or 1/N)")->capture_default_str();
@@ -487,6 +493,19 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--pile-count", opts->pile_count, "bodies per pile")->capture_default_str();
   cmd->add_option("--pile-reference-dt", *pile_dt_text, "step of the reference in piles, s (a number or 1/N)")
       ->capture_default_str();
+  cmd->add_option("--pile-reference-iterations", opts->pile_reference_iterations,
+                  "solver iterations per step of the reference in piles and scenes")
+      ->capture_default_str();
+  cmd->add_option("--convergence", opts->convergence,
+                  "step or iterations: run only the reference of --scenes and the drop piles at --refinements + 1 "
+                  "levels (the step halved, or the iterations doubled, from one to the next) and report each "
+                  "figure's change beside its noise floor")
+      ->check(CLI::IsMember({"step", "iterations"}));
+  cmd->add_option("--refinements", opts->refinements, "--convergence: levels after the first")->capture_default_str();
+  auto convergence_json_path = std::make_shared<std::string>();
+  cmd->add_option("--convergence-json", *convergence_json_path,
+                  "JSON of an earlier --convergence run: only print its tables again (compared anew)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--scenes", *scene_list,
                   "comma-separated pile scenes (tools/scenes/piles.hpp): heap, bin, stack (= column,wall), column, "
                   "wall; against Bullet full at --pile-reference-dt with statsim bench's settings");
@@ -548,6 +567,13 @@ void register_fidelity_commands(CLI::App& app)
         write_charts(std::filesystem::path(*replot), charts);
         return;
       }
+      if (!convergence_json_path->empty()) {
+        std::ifstream in(*convergence_json_path);
+        std::stringstream text;
+        text << in.rdbuf();
+        std::cout << convergence_table(convergence_from_json(text.str())) << std::flush;
+        return;
+      }
       o.dt = parse_step(*dt_text, "--dt");
       o.reference_dt = parse_step(*reference_dt_text, "--reference-dt");
       o.pile_reference_dt = parse_step(*pile_dt_text, "--pile-reference-dt");
@@ -560,6 +586,14 @@ void register_fidelity_commands(CLI::App& app)
       if (!bytes_chart_path->empty())
         ensure_writable_directory(std::filesystem::absolute(*bytes_chart_path).parent_path());
       if (charts.any()) plot::find_python();  // a missing matplotlib too
+      if (!o.convergence.empty()) {
+        if (charts.any()) throw std::invalid_argument("--convergence draws no chart");
+        ConvergenceResult r = run_convergence(o);
+        r.command = command_line(o);
+        std::cout << convergence_table(r) << std::flush;
+        if (!json_path->empty()) write_file_atomic(*json_path, convergence_json(r));
+        return;
+      }
       FidelityResult r = run_fidelity(o);
       r.command = command_line(o);
       std::cout << fidelity_table(r) << std::flush;

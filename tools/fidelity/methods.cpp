@@ -132,7 +132,10 @@ std::unique_ptr<bench::Sim> build(const Setup& setup, const MethodSpec& m, const
   if (m.bullet) {
     // Shapes per world: GImpact shapes keep mutable lock state, so worlds on different threads
     // must not share them.
-    return bench::make_bullet(bench::make_bullet_shapes(setup.body), m.bullet_method, "sap", scene, dt);
+    const std::shared_ptr<bench::BulletShapes> shapes = bench::make_bullet_shapes(setup.body);
+    bullet::DropSettings s = bench::bullet_drop_settings(setup.body, m.bullet_method, "sap", scene);
+    s.solver_iterations = m.solver_iterations;
+    return bench::make_bullet(shapes, m.bullet_method, s, scene.bodies, dt);
   }
   return bench::make_statsim3_table(m.table, setup.body.mass, scene, seed, dt, "", m.variant);
 }
@@ -249,14 +252,19 @@ Setup make_setup(const FidelityOptions& o)
       m.gather_reference = true;
       m.bullet_method = "full";
       m.description = "Bullet full, statsim gather's settings (piles and step time: statsim bench's)";
-    } else if (name == "statistical" || name == "statistical-norest" || name == "statistical-independent") {
+    } else if (name == "statistical" || name == "statistical-norest" || name == "statistical-independent" ||
+               name == "statistical-spheres") {
       m.table = base;
       m.table_bytes = base_bytes;
       m.variant.rest_conditions = name != "statistical-norest";
       m.variant.independent_pairs = name == "statistical-independent";
+      // The library's default body-body model; the others take hull contacts where the table has
+      // body-body data, as statsim bench does.
+      m.variant.hull_contacts = name != "statistical-spheres";
       m.description = "statsim, " + base_name +
                       (name == "statistical-norest" ? ", resting conditions off"
                        : name == "statistical-independent" ? ", independent pair response"
+                       : name == "statistical-spheres"     ? ", collision spheres between bodies (the library's default)"
                                                            : ", momentum pair response, resting conditions on");
     } else if (name.rfind("statistical:", 0) == 0) {
       const std::string t = name.substr(12);
@@ -268,7 +276,7 @@ Setup make_setup(const FidelityOptions& o)
     } else {
       throw std::invalid_argument("unknown method '" + name +
                                   "' (full, full-gather, low, hull, spheres7, sphere, statistical, statistical-norest, "
-                                  "statistical-independent, statistical:NAME)");
+                                  "statistical-independent, statistical-spheres, statistical:NAME)");
     }
     s.methods.push_back(m);
   }

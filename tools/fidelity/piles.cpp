@@ -66,9 +66,7 @@ PileRun run_pile(const Setup& setup, const MethodSpec& m, std::uint64_t seed, in
 }
 
 
-namespace {
-
-std::vector<std::string> expand_scenes(const std::vector<std::string>& names)
+std::vector<std::string> scene_kinds(const std::vector<std::string>& names)
 {
   std::vector<std::string> out;
   auto add = [&](const std::string& k) {
@@ -80,6 +78,8 @@ std::vector<std::string> expand_scenes(const std::vector<std::string>& names)
   }
   return out;
 }
+
+namespace {
 
 // A stack's pose for a shape built of boxes: the first box's axes along the world's (a box face
 // down, the L-shape flat on its large face). The L-shape's body frame is its principal frame;
@@ -166,6 +166,15 @@ std::string describe_scene(const scenes::PileScene3& sc, const FidelityOptions& 
   return b;
 }
 
+}  // namespace
+
+std::string scene_description(const Setup& setup, const FidelityOptions& o, const std::string& kind)
+{
+  return describe_scene(make_scene(setup, o, kind, 1), o);
+}
+
+namespace {
+
 struct SceneOutcome {
   SceneRun run;
   std::vector<scenes::BodyState3> states;  // final
@@ -186,6 +195,7 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
     // dbvt: the sweep-and-prune broad phase holds N + 2 handles, too few with the bin's walls.
     bullet::DropSettings s = bench::bullet_drop_settings(setup.body, m.bullet_method, "dbvt", drop);
     s.planes = planes;
+    s.solver_iterations = m.solver_iterations;
     if (sc.shapes.empty())
       sim = bench::make_bullet(bench::make_bullet_shapes(setup.body), m.bullet_method, s, sc.bodies, dt);
     else
@@ -332,6 +342,14 @@ void summarise(SceneSample& s, const std::vector<SceneMetric>& metrics, const st
 
 }  // namespace
 
+SceneRun run_scene_seed(const Setup& setup, const MethodSpec& m, const FidelityOptions& o, const std::string& kind,
+                        std::uint64_t seed, double dt)
+{
+  std::vector<double> volumes{mesh_volume(setup.body)};
+  if (setup.mixed) volumes.push_back(mesh_volume(setup.mix_body));
+  return run_scene(setup, m, make_scene(setup, o, kind, seed), o, dt, mix(o.seed, seed), volumes).run;
+}
+
 std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o, unsigned threads)
 {
   std::vector<SceneResult> results;
@@ -343,11 +361,12 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
   ref.name = "reference";
   ref.bullet = true;
   ref.bullet_method = "full";
-  for (const std::string& kind : expand_scenes(o.scenes)) {
+  ref.solver_iterations = o.pile_reference_iterations;
+  for (const std::string& kind : scene_kinds(o.scenes)) {
     SceneResult res;
     res.kind = kind;
     res.metrics = scene_metrics(kind);
-    res.description = describe_scene(make_scene(setup, o, kind, 1), o);
+    res.description = scene_description(setup, o, kind);
     Progress progress(("fidelity: " + kind).c_str(), samples * seeds, o.progress);
     // Job j: sample j % samples, seed index j / samples (the expensive reference runs spread out).
     const std::vector<SceneOutcome> all = parallel_map(

@@ -33,6 +33,7 @@ struct MethodSpec {
   bool bullet = false;
   bool gather_reference = false;  // tools/ref3d's Bullet world (single drops only)
   std::string bullet_method;  // full, low, hull, spheres7, sphere
+  int solver_iterations = 10;  // Bullet's solver iterations per step (statsim bench's worlds)
   SignatureView<3> table{};
   bench::StatsimVariant variant;
   long long table_bytes = -1;
@@ -78,6 +79,13 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
 /// The drop pile of `seed` of method `m`.
 PileRun run_pile(const Setup& setup, const MethodSpec& m, std::uint64_t seed, int count, double dt, double limit,
                  std::uint64_t world_seed);
+/// The scene kinds of --scenes in order, "stack" as column and wall.
+std::vector<std::string> scene_kinds(const std::vector<std::string>& names);
+/// The pile scene `kind` in one line (its set-up, as the report prints it).
+std::string scene_description(const Setup& setup, const FidelityOptions& o, const std::string& kind);
+/// One run of the pile scene `kind` (heap, bin, column, wall) of `seed`, method `m` at `dt`.
+SceneRun run_scene_seed(const Setup& setup, const MethodSpec& m, const FidelityOptions& o, const std::string& kind,
+                        std::uint64_t seed, double dt);
 /// The pile scenes of --scenes, every method against the reference.
 std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o, unsigned threads);
 

@@ -144,7 +144,7 @@ MethodResult run_box2d_once(const Compare2dOptions& o, const Shape2& shape, cons
   const int every = history_steps(o);
   for (int step = 0; step < o.steps; ++step) {
     const auto t0 = std::chrono::steady_clock::now();
-    world.Step(h, 8, 3);
+    for (int sub = 0; sub < o.box2d_substeps; ++sub) world.Step(h / static_cast<float>(o.box2d_substeps), 8, 3);
     const auto t1 = std::chrono::steady_clock::now();
     m.step_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     int awake = 0;
@@ -383,6 +383,11 @@ MethodResult pool(const std::vector<MethodResult>& drops)
       p.histogram[c] += d.histogram[c] / k;
     }
   }
+  double ss = 0.0;
+  for (const MethodResult& d : drops) {
+    ss += (d.pile_height - p.pile_height) * (d.pile_height - p.pile_height);
+  }
+  p.pile_height_sd = drops.size() > 1 ? std::sqrt(ss / (k - 1.0)) : 0.0;
   return p;
 }
 
@@ -432,6 +437,9 @@ Compare2dResult run_compare2d(const Compare2dOptions& o)
   }
   if (!(o.dt > 0.0 && o.dt <= 0.1)) {
     throw std::invalid_argument("--dt must be in (0, 0.1] s");
+  }
+  if (o.box2d_substeps < 1 || o.box2d_substeps > 64) {
+    throw std::invalid_argument("--box2d-substeps must be in 1..64");
   }
   const Shape2 shape = shape_for(o.shape);
   const std::optional<statsim::SignatureView<2>> sig = signature_for(o.shape);
@@ -512,7 +520,8 @@ std::string compare2d_table(const Compare2dResult& r)
        " drops (seeds " + std::to_string(o.seed) + ".." + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops) - 1) +
        ") of " + std::to_string(o.steps) + " steps of " + fmt("%.5g", o.dt) +
        " s; step times: least of " + std::to_string(o.repeat) + " identical runs, mean over the drops" +
-       (o.pile_rest ? "; statsim with pile_rest" : "") + "\n";
+       (o.pile_rest ? "; statsim with pile_rest" : "") +
+       (o.box2d_substeps > 1 ? "; Box2D in " + std::to_string(o.box2d_substeps) + " substeps per step" : "") + "\n";
   t += "box2d_b: Box2D on seeds " + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops)) + ".." +
        std::to_string(o.seed + static_cast<std::uint64_t>(2 * o.drops) - 1) +
        ", a second sample of the reference: its distances are the noise floor\n";
@@ -542,6 +551,8 @@ std::string compare2d_table(const Compare2dResult& r)
   row("mean |x - mean| (m)", fmt("%.3f", b.mad_x), fmt("%.3f", s.mad_x), fmt("%.3f", bb.mad_x));
   row("spread W1 / box2d spread", "0", fmt("%.3f", s.spread_w1), fmt("%.3f", bb.spread_w1));
   row("pile height (m)", fmt("%.3f", b.pile_height), fmt("%.3f", s.pile_height), fmt("%.3f", bb.pile_height));
+  row("pile height, sd over drops (m)", fmt("%.3f", b.pile_height_sd), fmt("%.3f", s.pile_height_sd),
+      fmt("%.3f", bb.pile_height_sd));
   row("lowest point (m)", fmt("%.4f", b.lowest), fmt("%.4f", s.lowest), fmt("%.4f", bb.lowest));
   row("nearest neighbour, median (m)", fmt("%.3f", b.neighbour_median), fmt("%.3f", s.neighbour_median),
       fmt("%.3f", bb.neighbour_median));
@@ -564,13 +575,14 @@ std::string compare2d_csv(const Compare2dResult& r)
 {
   std::string s =
       "method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep,drops,"
-      "rest_tvd_single,neighbour_median\n";
+      "rest_tvd_single,neighbour_median,pile_height_sd\n";
   for (const MethodResult* m : {&r.box2d, &r.box2d_b, &r.statsim}) {
     s += m->method + "," + std::to_string(r.options.n) + "," + std::to_string(r.options.steps) + "," +
          fmt("%.6f", m->median_ms) + "," + fmt("%.6f", m->mean_ms) + "," + fmt("%.6f", m->falling_median_ms) + "," +
          fmt("%.6f", m->active_mean_ms) + "," + fmt("%.6f", m->rest_tvd) + "," + fmt("%.6f", m->spread_w1) + "," +
          fmt("%.6f", m->pile_height) + "," + std::to_string(m->asleep) + "," + std::to_string(r.options.drops) + "," +
-         fmt("%.6f", m->rest_tvd_single) + "," + fmt("%.6f", m->neighbour_median) + "\n";
+         fmt("%.6f", m->rest_tvd_single) + "," + fmt("%.6f", m->neighbour_median) + "," +
+         fmt("%.6f", m->pile_height_sd) + "\n";
   }
   return s;
 }
@@ -626,6 +638,10 @@ void register_compare2d_command(CLI::App& app)
                  "Independent drops per method (seeds seed, seed+1, ...), pooled; Box2D also runs the next "
                  "drops seeds as a second reference sample, the noise floor")
       ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  c->add_option("--box2d-substeps", cmd->options.box2d_substeps,
+                "Box2D takes this many steps of dt / N for each step (its convergence); statsim steps dt")
+      ->check(CLI::Range(1, 64))
       ->capture_default_str();
   c->add_flag("--pile-rest", cmd->options.pile_rest,
               "statsim: bodies settling on other bodies blend to the mean rest height (WorldDef::pile_rest)");

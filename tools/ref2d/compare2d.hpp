@@ -29,6 +29,9 @@ struct Compare2dOptions {
   /// own share of tilted bodies varies widely between seeds (tools/ref2d/README.md).
   int drops = 10;
   bool pile_rest = false;        ///< statsim's WorldDef::pile_rest
+  /// Box2D takes this many steps of dt / box2d_substeps for each step of dt (its convergence:
+  /// tools/ref2d/convergence2d.py); statsim always steps dt.
+  int box2d_substeps = 1;
   /// When above 0: every this many seconds of simulated time (rounded to whole steps), record the
   /// highest centre and the bodies awake (`MethodResult::history`).
   double history_every = 0.0;
@@ -63,6 +66,7 @@ struct MethodResult {
   std::vector<HistorySample> history;  ///< when Compare2dOptions::history_every > 0
   std::vector<double> histogram;      ///< fractions per rest pose of the signature, then "other"
   double pile_height = 0.0;           ///< highest point of any body (its polygon at its pose), m; mean over drops
+  double pile_height_sd = 0.0;        ///< standard deviation of pile_height over the drops, m
   double mean_x = 0.0;
   double mad_x = 0.0;                 ///< mean absolute deviation of x within a drop, m; mean over drops
   double rest_tvd = 0.0;              ///< total variation distance of the pooled histograms to Box2D's
@@ -117,7 +121,7 @@ Compare2dResult run_compare2d(const Compare2dOptions& options);
 /// The side-by-side table for humans.
 std::string compare2d_table(const Compare2dResult& result);
 
-/// CSV: header `method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep,drops,rest_tvd_single`,
+/// CSV: header `method,n,steps,step_ms,step_ms_mean,falling_ms,active_ms,rest_tvd,spread_w1,pile_height,asleep,drops,rest_tvd_single,neighbour_median,pile_height_sd`,
 /// one row per method: box2d (distances 0), box2d_b (the noise floor), statsim. step_ms is the
 /// median over all steps.
 std::string compare2d_csv(const Compare2dResult& result);
