@@ -690,3 +690,18 @@ TEST_CASE("fidelity: statistical-spheres is the library's default body-body mode
   CHECK(hulls < 1.02);
   CHECK(spheres > hulls + 0.05);
 }
+
+TEST_CASE("fidelity: each pile scene's reference runs at its own converged step unless one is given")
+{
+  FidelityOptions o;
+  CHECK(o.pile_reference_dt == 0.0);
+  CHECK(pile_reference_step(o, "heap") == doctest::Approx(1.0 / 3840));
+  CHECK(pile_reference_step(o, "bin") == doctest::Approx(1.0 / 960));
+  CHECK(pile_reference_step(o, "column") == doctest::Approx(1.0 / 480));
+  CHECK(pile_reference_step(o, "wall") == doctest::Approx(1.0 / 480));
+  CHECK(pile_reference_step(o, "piles") == doctest::Approx(1.0 / 960));
+  o.pile_reference_dt = 1.0 / 240;
+  for (const char* kind : {"heap", "bin", "column", "wall", "piles"}) CHECK(pile_reference_step(o, kind) == 1.0 / 240);
+  o.pile_reference_dt = -1;
+  CHECK_THROWS_AS(validate(o), std::invalid_argument);
+}

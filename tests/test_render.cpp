@@ -355,3 +355,24 @@ TEST_CASE("reference-run: hull contacts are refused for Bullet, and nothing is w
   CHECK(error.find("--hull-contacts") != std::string::npos);
   CHECK_FALSE(std::ifstream(o.frames).good());
 }
+
+TEST_CASE("reference-run: Bullet's substeps refine its step, and a bad count is refused with nothing written")
+{
+  statsim::testing::TempDir dir("reference-run");
+  render::ReferenceRunOptions o = run_options("bunnies3", "bullet", dir.file("four.csv"));
+  o.seconds = 0.5;
+  o.every = 30;
+  std::string error;
+  CAPTURE(error);
+  REQUIRE(render::reference_run(o, error));
+  o.substeps = 8;
+  o.frames = dir.file("eight.csv");
+  REQUIRE(render::reference_run(o, error));
+  // The same scene at half the step: the bunnies fall the same way, but not to the same bits.
+  CHECK(read_all(dir.file("four.csv")) != read_all(dir.file("eight.csv")));
+  o.substeps = 0;
+  o.frames = dir.file("none.csv");
+  CHECK_FALSE(render::reference_run(o, error));
+  CHECK(error.find("--substeps") != std::string::npos);
+  CHECK_FALSE(std::ifstream(o.frames).good());
+}

@@ -135,7 +135,8 @@ void compare_levels(ConvergenceScene& scene)
 
 std::vector<SceneMetric> pile_convergence_metrics()
 {
-  return {{"mean_radius", "m", false}, {"mean_height", "m", false}, {"in_rest_pose", "", false}};
+  // The means are relative figures: their resolution is a share of the mean.
+  return {{"mean_radius", "m", true}, {"mean_height", "m", true}, {"in_rest_pose", "", false}};
 }
 
 ConvergenceResult run_convergence(const FidelityOptions& options)
@@ -156,8 +157,9 @@ ConvergenceResult run_convergence(const FidelityOptions& options)
     res.settings.push_back("reference (statsim bench's settings): " + line);
 
   const int levels = options.refinements + 1;
-  auto level_dt = [&](int k) {
-    return options.convergence == "step" ? options.pile_reference_dt / std::ldexp(1.0, k) : options.pile_reference_dt;
+  auto level_dt = [&](const std::string& kind, int k) {
+    const double dt = pile_reference_step(options, kind);
+    return options.convergence == "step" ? dt / std::ldexp(1.0, k) : dt;
   };
   auto level_iterations = [&](int k) {
     return options.convergence == "iterations" ? options.pile_reference_iterations << k
@@ -180,7 +182,7 @@ ConvergenceResult run_convergence(const FidelityOptions& options)
     }
     for (int k = 0; k < levels; ++k) {
       ConvergenceLevel l;
-      l.dt = level_dt(k);
+      l.dt = level_dt(kind, k);
       l.iterations = level_iterations(k);
       sc.levels.push_back(l);
     }

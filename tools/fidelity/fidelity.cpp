@@ -225,7 +225,7 @@ FidelityResult run_fidelity(const FidelityOptions& options)
         "fidelity: piles", samples, seeds, threads, options.progress, res,
         [&](std::size_t sample, std::size_t k) {
           const MethodSpec& m = sample < 2 ? pile_ref : setup->methods[sample - 2];
-          const double dt = sample < 2 ? options.pile_reference_dt : options.dt;
+          const double dt = sample < 2 ? pile_reference_step(options, "piles") : options.dt;
           const std::uint64_t seed = 1 + k + (sample == 1 ? seeds : 0);
           return run_pile(*setup, m, seed, options.pile_count, dt, options.time_limit, mix(options.seed, seed));
         },

@@ -35,7 +35,9 @@ struct FidelityOptions {
   bool piles = true;
   int pile_seeds = 20;               ///< piles: scene seeds 1..N (reference floor: N+1..2N)
   int pile_count = 50;               ///< bodies per pile
-  double pile_reference_dt = 1.0 / 240.0;  ///< s
+  /// s, step of the piles' and scenes' reference; 0: each scene's own converged step
+  /// (pile_reference_step()).
+  double pile_reference_dt = 0.0;
   /// Iterations of the piles' and scenes' reference solver per step (statsim bench's Bullet
   /// settings otherwise; Bullet's default is 10).
   int pile_reference_iterations = 10;
@@ -71,6 +73,12 @@ struct FidelityOptions {
   /// Bullet full only.
   std::string mix;
 };
+
+/// The step of the reference (Bullet full, statsim bench's settings) in the pile scene `kind`
+/// (heap, bin, column, wall, or "piles": the 50-body drop piles): `o.pile_reference_dt` when set,
+/// else the scene's converged step, the coarsest that `statsim fidelity --convergence step` found
+/// no refinement to move (tools/fidelity/README.md, "Is the reference converged?").
+double pile_reference_step(const FidelityOptions& o, const std::string& kind);
 
 /// Method names used when none are given: full, low, spheres7, sphere, statistical,
 /// statistical-norest, statistical-independent (those the shape supports).

@@ -189,8 +189,10 @@ std::string command_line(const FidelityOptions& o)
     << o.reference_dt << " --time-limit "
     << o.time_limit;
   if (o.piles || !o.scenes.empty())
-    c << " --pile-seeds " << o.pile_seeds << " --pile-count " << o.pile_count << " --pile-reference-dt "
-      << o.pile_reference_dt;
+  {
+    c << " --pile-seeds " << o.pile_seeds << " --pile-count " << o.pile_count;
+    if (o.pile_reference_dt > 0) c << " --pile-reference-dt " << o.pile_reference_dt;
+  }
   if (o.pile_reference_iterations != 10) c << " --pile-reference-iterations " << o.pile_reference_iterations;
   if (!o.convergence.empty()) c << " --convergence " << o.convergence << " --refinements " << o.refinements;
   if (!o.piles) c << " --no-piles";
@@ -303,13 +305,16 @@ std::string scenes_table(const FidelityResult& r)
   std::ostringstream s;
   s << "# statsim fidelity, pile scenes: " << r.shape << " (R = " << num(r.bounding_radius, "%.4f") << " m), "
     << r.options.scene_seeds << " seeds per sample\n\nReference: Bullet full at dt "
-    << num(r.options.pile_reference_dt, "%.5g") << " s with the settings of statsim bench; methods at dt "
+    << (r.options.pile_reference_dt > 0 ? num(r.options.pile_reference_dt, "%.5g") + " s"
+                                        : std::string("each scene's own step (below)"))
+    << " with the settings of statsim bench; methods at dt "
     << num(r.options.dt, "%.5g")
     << " s. Means over the seeds and distances to reference A (relative: (mean - mean_ref) / mean_ref; else the "
        "difference in the unit), with 90% bootstrap intervals over the seeds; the noise floor is reference B "
        "(seeds N+1..2N) against A.\n";
   for (const SceneResult& sc : r.scenes) {
-    s << "\n## " << sc.kind << "\n\n" << sc.description << "\n\n| sample |";
+    s << "\n## " << sc.kind << "\n\n" << sc.description << "; reference at dt " << num(sc.reference.dt, "%.5g")
+      << " s\n\n| sample |";
     for (const SceneMetric& m : sc.metrics)
       s << " " << m.name << (m.unit.empty() ? "" : " (" + m.unit + ")") << " | "
         << (m.relative ? "relative distance" : "difference") << " |";
@@ -350,7 +355,8 @@ std::string fidelity_table(const FidelityResult& r)
   s << "\n\nReference: Bullet full at dt " << num(r.options.reference_dt, "%.5g") << " s with the settings of statsim "
     << r.options.reference;
   if (r.options.piles)
-    s << " (piles: at " << num(r.options.pile_reference_dt, "%.5g") << " s with the settings of statsim bench)";
+    s << " (piles: at " << num(pile_reference_step(r.options, "piles"), "%.5g")
+      << " s with the settings of statsim bench)";
   s << "; methods at dt " << num(r.options.dt, "%.5g") << " s. Distances with 90% bootstrap intervals.\n\n";
   s << "| method | rest_tvd | rest_height_err | travel_w1 | bounce_w1 | rest_time_w1 | not rested | "
        "first_impact_ks (v, w) | no flight |";
@@ -458,7 +464,7 @@ void register_fidelity_commands(CLI::App& app)
   auto replot = std::make_shared<std::string>();
   auto dt_text = std::make_shared<std::string>("1/60");
   auto reference_dt_text = std::make_shared<std::string>("0.001");
-  auto pile_dt_text = std::make_shared<std::string>("1/240");
+  auto pile_dt_text = std::make_shared<std::string>("0");
   CLI::App* cmd = app.add_subcommand(
       "fidelity",
       std::string("Accuracy against speed: every method's single drops (and piles) against Bullet with the full "
@@ -491,7 +497,9 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_flag("--no-piles", *no_piles, "skip the piles");
   cmd->add_option("--pile-seeds", opts->pile_seeds, "piles: scene seeds 1..N (noise floor N+1..2N)")->capture_default_str();
   cmd->add_option("--pile-count", opts->pile_count, "bodies per pile")->capture_default_str();
-  cmd->add_option("--pile-reference-dt", *pile_dt_text, "step of the reference in piles, s (a number or 1/N)")
+  cmd->add_option("--pile-reference-dt", *pile_dt_text,
+                  "step of the reference in piles and scenes, s (a number or 1/N); 0: each scene's converged step "
+                  "(heap 1/3840, bin 1/960, column and wall 1/480, drop piles 1/960)")
       ->capture_default_str();
   cmd->add_option("--pile-reference-iterations", opts->pile_reference_iterations,
                   "solver iterations per step of the reference in piles and scenes")

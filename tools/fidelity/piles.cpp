@@ -375,7 +375,7 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
           const std::size_t sample = job % samples, k = job / samples;
           const std::uint64_t seed = 1 + k + (sample == 1 ? seeds : 0);
           const MethodSpec& m = sample < 2 ? ref : setup.methods[sample - 2];
-          const double dt = sample < 2 ? o.pile_reference_dt : o.dt;
+          const double dt = sample < 2 ? pile_reference_step(o, kind) : o.dt;
           SceneOutcome r = run_scene(setup, m, make_scene(setup, o, kind, seed), o, dt, mix(o.seed, seed), volumes);
           progress.add();
           if (k != 0 || o.scene_frames.empty()) r.states.clear();
@@ -383,9 +383,9 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
         },
         threads);
     res.reference.name = "reference";
-    res.reference.dt = o.pile_reference_dt;
+    res.reference.dt = pile_reference_step(o, kind);
     res.reference_b.name = "reference_b";
-    res.reference_b.dt = o.pile_reference_dt;
+    res.reference_b.dt = pile_reference_step(o, kind);
     res.methods.resize(setup.methods.size());
     for (std::size_t i = 0; i < setup.methods.size(); ++i) {
       res.methods[i].name = setup.methods[i].name;

@@ -24,8 +24,6 @@ namespace statsim::tools::render {
 namespace {
 
 constexpr std::uint32_t kCapacity = 4096;
-// Bullet steps a frame in this many internal steps: GImpact at 1/60 s lets fast bunnies sink.
-constexpr int kSubsteps = 4;
 using RunWorld = World3<kCapacity>;
 
 struct Written {
@@ -56,6 +54,10 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
   }
   if (o.hull_contacts && o.engine != "statsim") {
     error = "--hull-contacts is statsim's (Bullet touches at its meshes)";
+    return false;
+  }
+  if (o.substeps < 1 || o.substeps > 256) {
+    error = "--substeps must be in 1..256";
     return false;
   }
   if (o.every < 1 || !(o.seconds > 0)) {
@@ -151,7 +153,7 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
   bullet::DropWorld world(body, scene.bodies, settings);
   std::size_t asleep = 0;
   for (int s = 0; s < steps; ++s) {
-    world.step(dt, kSubsteps);
+    world.step(dt, o.substeps);
     if (s % o.every != 0) continue;
     asleep = 0;
     for (std::size_t i = 0; i < world.size(); ++i) {
@@ -161,9 +163,9 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
       write_frame_row(out.f, s, double(s + 1) * dt, int(i), "bunny", b.position, b.orientation, sleeping ? 2 : 0, 0.0);
     }
   }
-  std::printf("reference-run: %s, Bullet (full bunny mesh, GImpact), %d steps of 1/60 s (4 substeps), %zu of %zu "
+  std::printf("reference-run: %s, Bullet (full bunny mesh, GImpact), %d steps of 1/60 s (%d substeps), %zu of %zu "
               "asleep at the last written frame -> %s\n",
-              o.scene.c_str(), steps, asleep, world.size(), o.frames.c_str());
+              o.scene.c_str(), steps, o.substeps, asleep, world.size(), o.frames.c_str());
   return true;
 }
 

@@ -18,6 +18,9 @@ struct ReferenceRunOptions {
   /// statsim: bodies touch at their hulls (`BodyContacts::hulls`, as `statsim bench` and
   /// `statsim fidelity` run them) instead of the paper's collision spheres, the library's default
   bool hull_contacts = false;
+  /// Bullet: internal steps per step of 1/60 s (4: 1/240 s; the 50-bunny piles' reference is
+  /// converged at 16, 1/960 s: tools/fidelity/README.md, "Is the reference converged?").
+  int substeps = 4;
   std::string meshes_dir;
 };
 

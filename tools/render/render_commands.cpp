@@ -270,6 +270,8 @@ void register_render_commands(CLI::App& app)
   rr->add_option("--seconds", o->seconds, "simulated seconds")->check(CLI::PositiveNumber)->capture_default_str();
   rr->add_option("--every", o->every, "write every k-th step of 1/60 s")->check(CLI::Range(1, 100000))->capture_default_str();
   rr->add_option("--seed", o->seed, "scene seed")->capture_default_str();
+  rr->add_option("--substeps", o->substeps, "Bullet: internal steps per step of 1/60 s (16: 1/960 s, the converged step)")
+      ->capture_default_str();
   rr->add_option("--meshes", o->meshes_dir, "directory of the meshes")->capture_default_str();
   rr->add_flag("--hull-contacts", o->hull_contacts,
                "statsim: bodies touch at their hulls (BodyContacts::hulls, as statsim bench and fidelity run them), "
