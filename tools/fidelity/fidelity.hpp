@@ -56,7 +56,7 @@ struct FidelityOptions {
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes
   bool progress = true;
   /// Pile scenes (tools/scenes/piles.hpp) to run: heap, bin, column, wall ("stack": column and
-  /// wall). Each against Bullet full at pile_reference_dt with statsim bench's settings.
+  /// wall). Each against Bullet full at pile_reference_step() with statsim bench's settings.
   std::vector<std::string> scenes;
   bool drops = true;                 ///< false: no single drops, piles or step time (scenes only)
   int scene_seeds = 10;              ///< scene seeds 1..N per sample (reference floor: N+1..2N)
