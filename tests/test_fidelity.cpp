@@ -705,3 +705,63 @@ TEST_CASE("fidelity: each pile scene's reference runs at its own converged step 
   o.pile_reference_dt = -1;
   CHECK_THROWS_AS(validate(o), std::invalid_argument);
 }
+
+TEST_CASE("fidelity: --scene-reference reads the reference samples of an earlier run instead of running them")
+{
+  TempDir dir("fidelity_scene_reference");
+  const std::string first = dir.file("first.json"), edited = dir.file("edited.json"), second = dir.file("second.json");
+  const std::vector<std::string> scene = {"--shape", "box", "--scenes", "column", "--scenes-only", "--methods",
+                                          "statistical", "--column-height", "3", "--stack-time", "0.5",
+                                          "--scene-seeds", "2", "--threads", "2", "--quiet"};
+  std::vector<std::string> args = scene;
+  args.insert(args.end(), {"--json", first});
+  REQUIRE(run_cli(args) == 0);
+  nlohmann::json j = nlohmann::json::parse(read_file(first));
+  // Mark the stored reference: a rerun of Bullet could not give a held height of 0.5.
+  for (nlohmann::json& run : j["scenes"]["column"]["reference"]["runs"]) run["held"] = 0.5;
+  {
+    std::ofstream out(edited);
+    out << j.dump(2);
+  }
+  args = scene;
+  args.insert(args.end(), {"--scene-reference", edited, "--json", second});
+  REQUIRE(run_cli(args) == 0);
+  const nlohmann::json k = nlohmann::json::parse(read_file(second));
+  const nlohmann::json& column = k.at("scenes").at("column");
+  CHECK(column.at("reference").at("means").at("held").get<double>() == 0.5);
+  // The method's runs are its own, the same as in the first run; its distance is to the stored A.
+  const nlohmann::json& was = j.at("scenes").at("column").at("methods").at("statistical");
+  const nlohmann::json& now = column.at("methods").at("statistical");
+  CHECK(now.at("means").at("held") == was.at("means").at("held"));
+  CHECK(now.at("distances").at("held").get<double>() ==
+        doctest::Approx(now.at("means").at("held").get<double>() - 0.5));
+  // Another scene set-up, another step or another shape is refused before anything runs.
+  args = scene;
+  args[8] = "4";  // --column-height
+  args.insert(args.end(), {"--scene-reference", first});
+  CHECK(run_cli(args) != 0);
+  args = scene;
+  args.insert(args.end(), {"--scene-reference", first, "--pile-reference-dt", "1/240"});
+  CHECK(run_cli(args) != 0);
+  args = scene;
+  args[1] = "lshape";
+  args.insert(args.end(), {"--scene-reference", first});
+  CHECK(run_cli(args) != 0);
+}
+
+TEST_CASE("fidelity: the committed box references still describe today's scenes")
+{
+  // tools/fidelity/references/box_scenes.json holds the converged references of the box's heap,
+  // bin and stacks (tools/fidelity/README.md); a change of a scene's set-up must be measured anew.
+  TempDir dir("fidelity_committed_reference");
+  const std::string out = dir.file("box.json");
+  REQUIRE(run_cli({"--shape", "box", "--scenes", "heap,bin,stack", "--scenes-only", "--scene-seeds", "10",
+                   "--heap-count", "150", "--methods", "statistical", "--pile-reference-dt", "1/3840",
+                   "--scene-reference", "tools/fidelity/references/box_scenes.json", "--threads", "2", "--json", out,
+                   "--quiet"}) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read_file(out));
+  CHECK(j.at("scenes").at("heap").at("reference").at("means").at("angle_deg").get<double>() ==
+        doctest::Approx(25.7).epsilon(0.002));
+  CHECK(j.at("scenes").at("bin").at("reference").at("means").at("packing").get<double>() ==
+        doctest::Approx(0.325).epsilon(0.005));
+}

@@ -151,8 +151,7 @@ ConvergenceResult run_convergence(const FidelityOptions& options)
 
   ConvergenceResult res;
   res.options = options;
-  res.shape = options.mesh.empty() ? options.shape : options.mesh;
-  if (!options.mix.empty()) res.shape += " and " + options.mix + " (mixed, half and half)";
+  res.shape = shape_label(options);
   for (const std::string& line : bench::bullet_settings(setup->body))
     res.settings.push_back("reference (statsim bench's settings): " + line);
 

@@ -154,8 +154,7 @@ FidelityResult run_fidelity(const FidelityOptions& options)
 
   FidelityResult res;
   res.options = options;
-  res.shape = options.mesh.empty() ? options.shape : options.mesh;
-  if (!options.mix.empty()) res.shape += " and " + options.mix + " (mixed, half and half)";
+  res.shape = shape_label(options);
   res.bounding_radius = setup->radius;
   for (std::uint32_t i = 0; i < setup->poses.rest.count; ++i) {
     char b[160];

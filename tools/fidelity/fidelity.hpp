@@ -68,6 +68,9 @@ struct FidelityOptions {
   int wall_height = 5;               ///< bodies per column of the wall
   double stack_time = 3.0;           ///< s, simulated time of the column and the wall
   std::string scene_frames;          ///< directory: final states of seed 1 as frame files; empty: none
+  /// JSON of an earlier run with the same scenes (`--json`): its reference samples A and B stand
+  /// in for running the reference again (tools/fidelity/scene_reference.hpp); empty: run it.
+  std::string scene_reference;
   /// Mixed heap and bin: half their bodies of this second shape (bunny, box or lshape, with its
   /// compiled table), taken in turn with `shape`'s; empty: one shape. Methods: statistical and
   /// Bullet full only.
@@ -79,6 +82,10 @@ struct FidelityOptions {
 /// else the scene's converged step, the coarsest that `statsim fidelity --convergence step` found
 /// no refinement to move (tools/fidelity/README.md, "Is the reference converged?").
 double pile_reference_step(const FidelityOptions& o, const std::string& kind);
+
+/// The shape a run measures as its report and JSON name it: the compiled shape or the mesh, and
+/// a mixed scene's second shape.
+std::string shape_label(const FidelityOptions& o);
 
 /// Method names used when none are given: full, low, spheres7, sphere, statistical,
 /// statistical-norest, statistical-independent (those the shape supports).

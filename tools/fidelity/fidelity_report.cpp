@@ -206,6 +206,7 @@ std::string command_line(const FidelityOptions& o)
       << " --bin-cells " << o.bin_cells << " --column-height " << o.column_height << " --wall-columns "
       << o.wall_columns << " --wall-height " << o.wall_height << " --stack-time " << o.stack_time;
     if (!o.mix.empty()) c << " --mix " << o.mix;
+    if (!o.scene_reference.empty()) c << " --scene-reference " << o.scene_reference;
   }
   c << " --seed " << o.seed << " --bootstrap " << o.bootstrap;
   return c.str();
@@ -532,6 +533,10 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--mix", opts->mix,
                   "heap and bin: half the bodies of this second shape (bunny, box, lshape), in turn with --shape's; "
                   "methods statistical and full only");
+  cmd->add_option("--scene-reference", opts->scene_reference,
+                  "JSON of an earlier --scenes run (--json) with the same scenes, seeds and reference step: its "
+                  "reference samples stand in for running the reference again")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--scene-frames", opts->scene_frames,
                   "directory: the final state of seed 1 of each scene, reference A and each method, as frame files "
                   "(KIND_METHOD.csv) for statsim render");

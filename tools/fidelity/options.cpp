@@ -11,6 +11,13 @@ std::vector<std::string> default_methods()
   return {"full", "low", "spheres7", "sphere", "statistical", "statistical-norest", "statistical-independent"};
 }
 
+std::string shape_label(const FidelityOptions& o)
+{
+  std::string s = o.mesh.empty() ? o.shape : o.mesh;
+  if (!o.mix.empty()) s += " and " + o.mix + " (mixed, half and half)";
+  return s;
+}
+
 double pile_reference_step(const FidelityOptions& o, const std::string& kind)
 {
   if (o.pile_reference_dt > 0) return o.pile_reference_dt;
@@ -49,6 +56,10 @@ void validate(const FidelityOptions& o)
   if (o.wall_columns < 1 || o.wall_columns > 100) bad("--wall-columns must be in [1, 100]");
   if (o.wall_height < 1 || o.wall_height > 1000) bad("--wall-height must be in [1, 1000]");
   if (!(o.stack_time > 0) || o.stack_time > 600) bad("--stack-time must be in (0, 600] s");
+  if (!o.scene_reference.empty() && o.scenes.empty()) bad("--scene-reference needs --scenes");
+  if (!o.scene_reference.empty() && !o.scene_frames.empty())
+    bad("--scene-frames needs the reference's final states: run the reference (no --scene-reference)");
+  if (!o.scene_reference.empty() && !o.convergence.empty()) bad("--convergence runs the reference itself");
   if (!o.mesh.empty() && o.tables.empty()) bad("--mesh needs --table NAME=FILE.json (the shape has no compiled table)");
   for (const auto& t : o.tables)
     if (t.first.empty() || t.second.empty()) bad("--table takes NAME=FILE.json");

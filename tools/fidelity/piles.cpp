@@ -5,11 +5,14 @@
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
 #include "fidelity/metrics.hpp"
+#include "fidelity/scene_reference.hpp"
 #include "scenes/frames.hpp"
 #include "scenes/piles.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace statsim::tools::fidelity {
@@ -362,11 +365,24 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
   ref.bullet = true;
   ref.bullet_method = "full";
   ref.solver_iterations = o.pile_reference_iterations;
+  std::string stored_text;
+  if (!o.scene_reference.empty()) {
+    std::ifstream in(o.scene_reference, std::ios::binary);
+    if (!in) throw std::runtime_error("--scene-reference: cannot read " + o.scene_reference);
+    std::ostringstream text;
+    text << in.rdbuf();
+    stored_text = text.str();
+  }
   for (const std::string& kind : scene_kinds(o.scenes)) {
     SceneResult res;
     res.kind = kind;
     res.metrics = scene_metrics(kind);
     res.description = scene_description(setup, o, kind);
+    const bool stored = !stored_text.empty();
+    StoredSceneReference from_file;
+    if (stored)
+      from_file = stored_scene_reference(stored_text, shape_label(o), kind, res.description, res.metrics, seeds,
+                                         pile_reference_step(o, kind));
     Progress progress(("fidelity: " + kind).c_str(), samples * seeds, o.progress);
     // Job j: sample j % samples, seed index j / samples (the expensive reference runs spread out).
     const std::vector<SceneOutcome> all = parallel_map(
@@ -374,6 +390,12 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
         [&](std::size_t job) {
           const std::size_t sample = job % samples, k = job / samples;
           const std::uint64_t seed = 1 + k + (sample == 1 ? seeds : 0);
+          if (stored && sample < 2) {
+            SceneOutcome r;
+            r.run = (sample == 0 ? from_file.a : from_file.b)[k];
+            progress.add();
+            return r;
+          }
           const MethodSpec& m = sample < 2 ? ref : setup.methods[sample - 2];
           const double dt = sample < 2 ? pile_reference_step(o, kind) : o.dt;
           SceneOutcome r = run_scene(setup, m, make_scene(setup, o, kind, seed), o, dt, mix(o.seed, seed), volumes);
