@@ -659,6 +659,11 @@ TEST_CASE("fidelity convergence: a heap of 20 at two steps reports each figure's
   const int converged = heap.at("converged_level");
   CHECK(converged >= -1);
   CHECK(converged <= 0);
+  // Two levels: the first holds exactly when every figure's change is within its floor.
+  bool within = true;
+  for (std::size_t m = 0; m < figures; ++m)
+    within = within && std::fabs(levels[0].at("change_to_next")[m].get<double>()) <= levels[0].at("floor")[m].get<double>();
+  CHECK(converged == (within ? 0 : -1));
   CHECK(levels[0].at("cpu_seconds").get<double>() > 0);
   // Read back, the run compares the same way.
   const ConvergenceResult back = convergence_from_json(read_file(json_path));

@@ -3,6 +3,7 @@
 
 #include "common/parallel.hpp"
 #include "common/progress.hpp"
+#include "common/sample_stats.hpp"
 #include "fidelity/stages.hpp"
 
 #include <nlohmann/json.hpp>
@@ -36,14 +37,14 @@ std::string step_text(double dt)
   return num(dt, "%.6g") + " s";
 }
 
+MeanStd level_stats(const ConvergenceLevel& level, std::size_t m)
+{
+  return mean_std(level.values.size(), [&](std::size_t i) { return level.values[i][m]; });
+}
+
 double level_sd(const ConvergenceLevel& level, std::size_t m)
 {
-  const std::size_t n = level.values.size();
-  if (n < 2) return 0.0;
-  const double mean = level_mean(level, m);
-  double s = 0;
-  for (const std::vector<double>& v : level.values) s += (v[m] - mean) * (v[m] - mean);
-  return std::sqrt(s / static_cast<double>(n - 1));
+  return level_stats(level, m).std;
 }
 
 std::string level_label(const ConvergenceLevel& l)
@@ -66,9 +67,7 @@ std::vector<double> pile_values(const PileRun& p, std::uint32_t poses)
 
 double level_mean(const ConvergenceLevel& level, std::size_t m)
 {
-  double s = 0;
-  for (const std::vector<double>& v : level.values) s += v[m];
-  return level.values.empty() ? 0.0 : s / static_cast<double>(level.values.size());
+  return level_stats(level, m).mean;
 }
 
 double convergence_resolution(const SceneMetric& metric)
@@ -212,11 +211,7 @@ ConvergenceResult run_convergence(const FidelityOptions& options)
       [&](std::size_t j) {
         const Job& job = jobs[j];
         const ConvergenceLevel& level = res.scenes[job.scene].levels[static_cast<std::size_t>(job.level)];
-        MethodSpec ref;
-        ref.name = "reference";
-        ref.bullet = true;
-        ref.bullet_method = "full";
-        ref.solver_iterations = level.iterations;
+        const MethodSpec ref = pile_reference_method(level.iterations);
         Outcome r;
         const double t0 = bench::thread_cpu_ms();
         if (res.scenes[job.scene].kind == "piles") {
@@ -236,19 +231,14 @@ ConvergenceResult run_convergence(const FidelityOptions& options)
         return r;
       },
       resolve_thread_count(options.threads));
-  // Results in seed order at every level (the jobs' order does not matter).
-  for (ConvergenceScene& sc : res.scenes)
-    for (ConvergenceLevel& l : sc.levels) l.values.clear();
-  for (std::size_t s = 0; s < res.scenes.size(); ++s)
-    for (int k = 0; k < levels; ++k)
-      for (std::size_t j = 0; j < jobs.size(); ++j) {
-        if (jobs[j].scene != s || jobs[j].level != k) continue;
-        ConvergenceLevel& l = res.scenes[s].levels[static_cast<std::size_t>(k)];
-        l.values.push_back(out[j].values);
-        l.time_limited += out[j].time_limited;
-        l.all_asleep += out[j].all_asleep;
-        l.cpu_seconds += out[j].cpu_ms / 1e3;
-      }
+  // The jobs of one scene and level are in seed order.
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    ConvergenceLevel& l = res.scenes[jobs[j].scene].levels[static_cast<std::size_t>(jobs[j].level)];
+    l.values.push_back(out[j].values);
+    l.time_limited += out[j].time_limited;
+    l.all_asleep += out[j].all_asleep;
+    l.cpu_seconds += out[j].cpu_ms / 1e3;
+  }
   for (ConvergenceScene& sc : res.scenes) compare_levels(sc);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return res;
@@ -331,29 +321,27 @@ std::string convergence_json(const ConvergenceResult& r)
       lj["values"] = l.values;
       std::vector<double> means, sds;
       for (std::size_t m = 0; m < sc.metrics.size(); ++m) {
-        means.push_back(level_mean(l, m));
-        sds.push_back(level_sd(l, m));
+        const MeanStd st = level_stats(l, m);
+        means.push_back(st.mean);
+        sds.push_back(st.std);
       }
       lj["means"] = means;
       lj["sds"] = sds;
       lj["time_limited"] = l.time_limited;
       lj["all_asleep"] = l.all_asleep;
       lj["cpu_seconds"] = l.cpu_seconds;
-      if (k < sc.changes.size()) {
+      auto put_changes = [&](const char* change_key, const char* floor_key, const std::vector<ConvergenceChange>& row) {
         std::vector<double> change, floor;
-        for (const ConvergenceChange& c : sc.changes[k]) {
+        for (const ConvergenceChange& c : row) {
           change.push_back(c.change);
           floor.push_back(c.floor);
         }
-        lj["change_to_next"] = change;
-        lj["floor"] = floor;
-        std::vector<double> drift, drift_floor;
-        for (const ConvergenceChange& c : sc.to_finest[k]) {
-          drift.push_back(c.change);
-          drift_floor.push_back(c.floor);
-        }
-        lj["change_to_finest"] = drift;
-        lj["floor_to_finest"] = drift_floor;
+        lj[change_key] = change;
+        lj[floor_key] = floor;
+      };
+      if (k < sc.changes.size()) {
+        put_changes("change_to_next", "floor", sc.changes[k]);
+        put_changes("change_to_finest", "floor_to_finest", sc.to_finest[k]);
       }
       levels.push_back(lj);
     }

@@ -185,9 +185,7 @@ FidelityResult run_fidelity(const FidelityOptions& options)
   ref.gather_reference = gather_ref;
   ref.bullet_method = "full";
   ref.description = "Bullet full";
-  MethodSpec pile_ref = ref;
-  pile_ref.gather_reference = false;
-  pile_ref.solver_iterations = options.pile_reference_iterations;
+  const MethodSpec pile_ref = pile_reference_method(options.pile_reference_iterations);
   const std::string which = gather_ref ? "Bullet full, statsim gather's settings" : "Bullet full, statsim bench's settings";
   res.reference.name = "reference";
   res.reference.description = which + ", sample A";

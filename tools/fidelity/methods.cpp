@@ -120,6 +120,17 @@ std::vector<std::string> gather_settings_lines(const ref3d::ShapeModel& m, const
   return out;
 }
 
+MethodSpec pile_reference_method(int solver_iterations)
+{
+  MethodSpec ref;
+  ref.name = "reference";
+  ref.description = "Bullet full";
+  ref.bullet = true;
+  ref.bullet_method = "full";
+  ref.solver_iterations = solver_iterations;
+  return ref;
+}
+
 std::unique_ptr<bench::Sim> build(const Setup& setup, const MethodSpec& m, const scenes::DropScene3& scene,
                                   std::uint64_t seed, double dt)
 {

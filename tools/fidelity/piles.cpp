@@ -360,11 +360,7 @@ std::vector<SceneResult> run_scenes(const Setup& setup, const FidelityOptions& o
   if (setup.mixed) volumes.push_back(mesh_volume(setup.mix_body));
   const std::size_t seeds = static_cast<std::size_t>(o.scene_seeds);
   const std::size_t samples = 2 + setup.methods.size();
-  MethodSpec ref;
-  ref.name = "reference";
-  ref.bullet = true;
-  ref.bullet_method = "full";
-  ref.solver_iterations = o.pile_reference_iterations;
+  const MethodSpec ref = pile_reference_method(o.pile_reference_iterations);
   std::string stored_text;
   if (!o.scene_reference.empty()) {
     std::ifstream in(o.scene_reference, std::ios::binary);

@@ -58,6 +58,9 @@ struct Setup {
 
 // The gathering's reference as a bench::Sim of one body (single drops): a Reference of its own,
 
+/// The piles' and scenes' reference: Bullet with the full mesh and statsim bench's settings, its
+/// solver at `solver_iterations` per step.
+MethodSpec pile_reference_method(int solver_iterations);
 /// The set-up of a run: the shape's bodies and tables, and each method to compare.
 Setup make_setup(const FidelityOptions& o);
 /// The world of method `m` for `scene`, statsim's seeded with `seed`, stepped at `dt`.

@@ -2,6 +2,7 @@
 #include "ref2d/compare2d.hpp"
 
 #include "common/format.hpp"
+#include "common/sample_stats.hpp"
 #include "common/pi.hpp"
 
 #include "common/atomic_file.hpp"
@@ -383,11 +384,7 @@ MethodResult pool(const std::vector<MethodResult>& drops)
       p.histogram[c] += d.histogram[c] / k;
     }
   }
-  double ss = 0.0;
-  for (const MethodResult& d : drops) {
-    ss += (d.pile_height - p.pile_height) * (d.pile_height - p.pile_height);
-  }
-  p.pile_height_sd = drops.size() > 1 ? std::sqrt(ss / (k - 1.0)) : 0.0;
+  p.pile_height_sd = mean_std(drops.size(), [&](std::size_t i) { return drops[i].pile_height; }).std;
   return p;
 }
 
