@@ -91,7 +91,7 @@ void write_def(SnapshotWriter& out, const WorldDef<D>& d)
   for (std::uint32_t b : {std::uint32_t(d.table_restitution_threshold), std::uint32_t(d.shock_propagation),
                           std::uint32_t(d.nearest_radius), std::uint32_t(d.pair_response),
                           std::uint32_t(d.body_contacts), std::uint32_t(d.rest_conditions),
-                          std::uint32_t(d.pile_rest), std::uint32_t(d.broad_phase)})
+                          std::uint32_t(d.pile_rest), std::uint32_t(d.broad_phase), std::uint32_t(d.sleep_islands)})
     out.u8(b);
 }
 
@@ -111,11 +111,11 @@ bool read_def(SnapshotReader& in, WorldDef<D>& d)
   d.position_iterations = int(std::int32_t(in.u32()));
   d.sweep_axis = int(std::int32_t(in.u32()));
   d.grid_above_bodies = in.u32();
-  std::uint8_t b[8];
+  std::uint8_t b[9];
   for (std::uint8_t& x : b) x = in.u8();
   for (int i = 0; i < 7; ++i)
     if (b[i] > 1) return false;
-  if (b[7] > 2) return false;
+  if (b[7] > 2 || b[8] > 1) return false;
   d.table_restitution_threshold = b[0] != 0;
   d.shock_propagation = b[1] != 0;
   d.nearest_radius = b[2] != 0;
@@ -124,6 +124,7 @@ bool read_def(SnapshotReader& in, WorldDef<D>& d)
   d.rest_conditions = b[5] != 0;
   d.pile_rest = b[6] != 0;
   d.broad_phase = BroadPhase(b[7]);
+  d.sleep_islands = b[8] != 0;
   return true;
 }
 
@@ -389,9 +390,9 @@ template <int D>
 constexpr std::size_t snapshot_capacity(std::uint32_t max_bodies, std::uint32_t max_planes, std::uint32_t max_shapes)
 {
   constexpr std::size_t s = sizeof(Scalar);
-  // Header, counters and widest; the `WorldDef` (gravity, seed, 15 scalars, 4 integers, 8 bytes);
+  // Header, counters and widest; the `WorldDef` (gravity, seed, 15 scalars, 4 integers, 9 bytes);
   // shapes, planes, body slots with their step start and sweep entry; the checksum.
-  return 32 + 24 + s + (D + 15) * s + 8 + 16 + 8 + 8 * std::size_t(max_shapes) + (D + 1) * s * max_planes +
+  return 32 + 24 + s + (D + 15) * s + 8 + 16 + 9 + 8 * std::size_t(max_shapes) + (D + 1) * s * max_planes +
          (15 + (D == 3 ? 20 : 13) * s + 4) * std::size_t(max_bodies) + 8;
 }
 

@@ -372,7 +372,7 @@ class WorldCore {
       std::uint32_t moves = detail::shock_pass(w_, ctx);
       for (int i = 0; i < w_.def.position_iterations && moves > 0; ++i) moves = detail::position_pass(w_, ctx);
     }
-    detail::update_motion_states<FS>(w_, dt);
+    detail::update_motion_states<FS>(w_, dt, ctx.touching);
     if constexpr (FS::queries) detail::measure_drift(w_);
     w_.touching_pairs = ctx.touching;
     result.energy_clamps = ctx.energy_clamps;

@@ -244,6 +244,15 @@ struct WorldDef {
   /// An awake body hitting a sleeping one faster than this (normal approach, m/s) wakes it;
   /// slower, the sleeper acts as a static support.
   Scalar wake_speed = Scalar(0.5);
+  /// Bodies fall asleep by islands (bodies connected through touching pairs), as rigid-body
+  /// engines put them to sleep: a body still for `sleep_time` waits until every awake body it
+  /// touches, directly or through others, is too, and they fall asleep in the same step; an
+  /// awake body that is not yet still wakes a sleeper it touches at any approach speed. Off (the
+  /// default): each body falls asleep on its own, and a sleeper is a static support unless hit
+  /// faster than `wake_speed`. A pile then freezes layer by layer as it forms, where a pile of
+  /// rigid bodies slumps under the bodies still landing on it (tools/fidelity/README.md, "A pile
+  /// model").
+  bool sleep_islands = false;
   /// Velocity damping, 1/s: v *= 1 / (1 + dt c). 0 = none.
   Scalar linear_damping = 0;
   /// Spin damping, 1/s. 0 = none.

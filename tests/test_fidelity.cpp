@@ -754,6 +754,44 @@ TEST_CASE("fidelity: --scene-reference reads the reference samples of an earlier
   CHECK(run_cli(args) != 0);
 }
 
+TEST_CASE("fidelity: a method's +FIELD=VALUE sets WorldDef fields, and the pile summary weighs each by its goal")
+{
+  TempDir dir("fidelity_world_settings");
+  const std::string out = dir.file("box.json");
+  std::vector<std::string> args = {"--shape", "box", "--scenes", "heap,bin", "--scenes-only", "--scene-seeds", "10",
+                                   "--heap-count", "150", "--pile-reference-dt", "1/3840", "--scene-reference",
+                                   "tools/fidelity/references/box_scenes.json", "--threads", "2", "--quiet", "--methods"};
+  std::vector<std::string> ok = args;
+  ok.insert(ok.end(), {"statistical,statistical+sleep_islands=1", "--json", out});
+  REQUIRE(run_cli(ok) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read_file(out));
+  const nlohmann::json& heap = j.at("scenes").at("heap").at("methods");
+  // The setting reaches the world: sleeping by islands lowers the box's heap.
+  CHECK(heap.at("statistical+sleep_islands=1").at("means").at("angle_deg").get<double>() <
+        heap.at("statistical").at("means").at("angle_deg").get<double>() - 3.0);
+  for (const std::string name : {"statistical", "statistical+sleep_islands=1"}) {
+    CAPTURE(name);
+    const nlohmann::json& d_heap = heap.at(name).at("distances");
+    const nlohmann::json& d_bin = j.at("scenes").at("bin").at("methods").at(name).at("distances");
+    const double expected = (std::fabs(d_heap.at("angle_deg").get<double>()) / 3.0 +
+                             std::fabs(d_heap.at("height").get<double>()) / 0.10 +
+                             std::fabs(d_bin.at("fill_height").get<double>()) / 0.05 +
+                             std::fabs(d_bin.at("packing").get<double>()) / 0.05) /
+                            4.0;
+    const nlohmann::json& summary = j.at("pile_summary").at(name);
+    CHECK(summary.at("pile_error").get<double>() == doctest::Approx(expected));
+    CHECK(summary.at("step_ms").get<double>() > 0);
+  }
+  // A misspelt field, a value the field does not take and a method that takes none are refused.
+  for (const std::string bad : {"statistical+sleep_island=1", "statistical+sleep_islands=2",
+                                "statistical+support_iterations=0", "statistical+sleep_time", "sphere+sleep_islands=1"}) {
+    CAPTURE(bad);
+    std::vector<std::string> refused = args;
+    refused.push_back(bad);
+    CHECK(run_cli(refused) != 0);
+  }
+}
+
 TEST_CASE("fidelity: the committed box references still describe today's scenes")
 {
   // tools/fidelity/references/box_scenes.json holds the converged references of the box's heap,

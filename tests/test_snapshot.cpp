@@ -62,7 +62,7 @@ constexpr std::size_t sweep_axis_offset()
 template <int D>
 std::size_t first_body(std::uint32_t shapes, std::uint32_t planes)
 {
-  return def_offset + 4 * D + 8 + 15 * 4 + 16 + 8 + 8 * shapes + planes * (D + 1) * 4;
+  return def_offset + 4 * D + 8 + 15 * 4 + 16 + 9 + 8 * shapes + planes * (D + 1) * 4;
 }
 
 /// Saves `a`, loads the bytes into `b` (which has the scene's shapes), and steps both `steps`
@@ -224,7 +224,7 @@ TEST_CASE("snapshot: refused loads leave the world as it was")
   SUBCASE("wrong version, dimension, scalar width, broad-phase storage")
   {
     Bytes b = good;
-    b[4] = 2;
+    b[4] = 1;  // the version before `WorldDef::sleep_islands`
     reseal(b);
     CHECK(refused(b, b.size()) == Status::snapshot_incompatible);
     b = good;

@@ -349,6 +349,12 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext<FS>& ctx)
       if (approach > def.wake_speed || wakes_by_overlap<FS>(w, a, b, c.depth, reach)) {
         if (a_asleep) wake(w, a);
         if (b_asleep) wake(w, b);
+      } else if (def.sleep_islands && (a_asleep ? b : a).slow_time == 0 && !(a_asleep && b_asleep)) {
+        // With islands (`WorldDef::sleep_islands`) an awake body that was not still in the last
+        // step joins the sleeper to its island, which sleeps once all of it is still. The sleeper
+        // keeps its still time: it wakes others only once it is pushed, and falls asleep again
+        // within `island_wait` sleep times of stillness even if a neighbour never comes to rest.
+        join_island(w, a_asleep ? a : b);
       }
     }
     Scalar ima, imb;

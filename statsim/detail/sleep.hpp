@@ -122,11 +122,81 @@ bool in_rest_pose(const WorldData<D>& w, const Body<D>& b, const typename Space<
   return u.dot(ground) >= w.def.rest_snap_cosine;
 }
 
-/// The last phase of a step: each awake body is moving, settling (touching and slower than
-/// `settle_speed`) or, once still for `sleep_time`, asleep; settling bodies follow the resting
-/// conditions.
+/// Puts an awake body to sleep where the last step left it: still, off the awake set, and, if it
+/// rests on the ground in its chosen pose (`posed`), exactly in that pose.
 template <class FS, int D>
-void update_motion_states(WorldData<D>& w, Scalar dt)
+void fall_asleep(WorldData<D>& w, Body<D>& b, std::uint32_t i, bool posed, const typename Space<D>::Vec& ground)
+{
+  using Vec = typename Space<D>::Vec;
+  b.state = MotionState::asleep;
+  clear_bit(w.awake, i);
+  --w.awake_count;
+  set_bit(w.flagged, i);  // its contact flags stay set until the next step clears them
+  b.linear_velocity = Vec::Zero();
+  b.angular_velocity = Space<D>::zero_spin();
+  if (b.rest_pose != no_rest_pose && b.on_ground && posed) {
+    // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
+    // the radius blend are below what a slow body would show.
+    // The centre stood `hull_radius` above the ground (the collision radius, or the hull's
+    // support where that is more): it ends at the pose's height above it.
+    const SignatureView<D>& sig = w.shapes[b.shape].signature;
+    const Scalar above = hull_radius<FS>(w, b, ground);
+    b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
+    const Scalar h = sig.rest.heights[b.rest_pose];
+    b.position += ground * (h - above);
+    b.radius = h;
+    b.rest_blend = 1;
+  }
+}
+
+/// With `WorldDef::sleep_islands`, sleep times after which a still body falls asleep whatever its
+/// island does (a still body out of its pose needs 3).
+constexpr Scalar island_wait = 4;
+
+/// `WorldDef::sleep_islands`: of the awake bodies marked ready in `ready` (still for their sleep
+/// time), unmarks every one connected to an unmarked awake body through the first `touching`
+/// pairs, then puts the ones left marked to sleep. A sleeper in a pair counts as ready: it woke in
+/// the impact pass if its awake neighbour was not. The marks spread along the pairs, which the
+/// shock pass left ordered from the bottom up, in sweeps up and down the buffer until one changes
+/// nothing: a pile's island takes a few sweeps, not one per body.
+template <class FS, int D>
+void sleep_islands(WorldData<D>& w, std::uint32_t* ready, std::uint32_t touching)
+{
+  using Vec = typename Space<D>::Vec;
+  const auto restless = [&](std::uint32_t i) {
+    return w.bodies[i].state != MotionState::asleep && !bit_set(ready, i);
+  };
+  const auto spread = [&](std::uint32_t k) {
+    const Pair& p = w.pairs[k];
+    const bool ra = restless(p.a), rb = restless(p.b);
+    if (ra == rb) return false;
+    const std::uint32_t calm = ra ? p.b : p.a;
+    if (w.bodies[calm].state == MotionState::asleep) return false;
+    clear_bit(ready, calm);
+    return true;
+  };
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::uint32_t k = 0; k < touching; ++k) changed = spread(k) || changed;
+    for (std::uint32_t k = touching; k-- > 0;) changed = spread(k) || changed;
+  }
+  for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
+    if (!bit_set(ready, i)) return;
+    Body<D>& b = w.bodies[i];
+    // As `update_motion_states` found it: a ready body is settling, and one that chose its pose
+    // in this step is not ready, so that the pose it turns toward is the one it had.
+    const Vec ground = b.on_ground ? ground_normal(w, b) : Vec(Vec::Unit(Space<D>::up_axis));
+    const bool posed = b.rest_pose == no_rest_pose || !b.on_ground || in_rest_pose(w, b, ground);
+    fall_asleep<FS>(w, b, i, posed, ground);
+  });
+}
+
+/// The last phase of a step: each awake body is moving, settling (touching and slower than
+/// `settle_speed`) or, once still for `sleep_time`, asleep (with `WorldDef::sleep_islands`, once
+/// its island is: `sleep_islands`); settling bodies follow the resting conditions. `touching`:
+/// the step's touching pairs, at the front of the pair buffer.
+template <class FS, int D>
+void update_motion_states(WorldData<D>& w, Scalar dt, std::uint32_t touching)
 {
   const bool tilted_planes = FS::slopes && w.tilted_planes;
   using Vec = typename Space<D>::Vec;
@@ -134,6 +204,11 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
   const Scalar settle2 = def.settle_speed * def.settle_speed;
   const Scalar sleep2 = def.sleep_speed * def.sleep_speed;
   const Scalar common = w.common_bound;
+  // The islands' marks go in the slope substeps' bit set, which nothing reads after the contact
+  // passes and the next step clears before it writes (`WorldData::rolled`).
+  std::uint32_t* const ready = def.sleep_islands ? w.rolled : nullptr;
+  if (ready)
+    for (std::uint32_t k = 0; k < bit_words(w.body_count); ++k) ready[k] = 0;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];
     const Scalar bound = common > 0 ? common : w.shapes[b.shape].bounding_radius;
@@ -187,28 +262,13 @@ void update_motion_states(WorldData<D>& w, Scalar dt)
     const bool wedged = !posed && hull_radius<FS>(w, b, ground) > b.radius;
     const bool still = !tipping && (lin2 > w2 ? lin2 : w2) < sleep2 && (posed || wedged);
     b.slow_time = still ? b.slow_time + dt : 0;
-    if (still && b.slow_time >= (posed ? def.sleep_time : 3 * def.sleep_time)) {
-      b.state = MotionState::asleep;
-      clear_bit(w.awake, i);
-      --w.awake_count;
-      set_bit(w.flagged, i);  // its contact flags stay set until the next step clears them
-      b.linear_velocity = Vec::Zero();
-      b.angular_velocity = Space<D>::zero_spin();
-      if (b.rest_pose != no_rest_pose && b.on_ground && posed) {
-        // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
-        // the radius blend are below what a slow body would show.
-        // The centre stood `hull_radius` above the ground (the collision radius, or the hull's
-        // support where that is more): it ends at the pose's height above it.
-        const SignatureView<D>& sig = w.shapes[b.shape].signature;
-        const Scalar above = hull_radius<FS>(w, b, ground);
-        b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
-        const Scalar h = sig.rest.heights[b.rest_pose];
-        b.position += ground * (h - above);
-        b.radius = h;
-        b.rest_blend = 1;
-      }
-    }
+    if (!still || b.slow_time < (posed ? def.sleep_time : 3 * def.sleep_time)) return;
+    // With islands a body still for `island_wait` sleep times sleeps whatever its island does: one
+    // body that never comes to rest would otherwise hold a whole pile awake.
+    if (!ready || b.slow_time >= island_wait * def.sleep_time) fall_asleep<FS>(w, b, i, posed, ground);
+    else if (turning || b.rest_pose == no_rest_pose) set_bit(ready, i);
   });
+  if (ready) sleep_islands<FS>(w, ready, touching);
 }
 
 }  // namespace detail

@@ -29,6 +29,7 @@ void hash_def(Fnv1a& h, const WorldDef<D>& d)
   // Added only when not the default, so that worlds from before the option keep their hashes.
   if (d.body_contacts != BodyContacts::collision_spheres) h.add(std::uint8_t(d.body_contacts));
   if (d.impact_threshold != WorldDef<D>{}.impact_threshold) h.add(d.impact_threshold);
+  if (d.sleep_islands) h.add(std::uint8_t(0x51));
 }
 
 /// Adds a table's numbers as the runtime reads them (16-bit ones as their values).

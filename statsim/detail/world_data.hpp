@@ -55,7 +55,9 @@ struct WorldData {
   /// last step's touching pairs (the only sleepers the passes mark).
   std::uint32_t* flagged;
   /// Bit set of the bodies that this step moved in substeps on a slope (`roll_on_slopes`): the
-  /// contact passes leave their slope contacts alone. Scratch of the step, not part of the state.
+  /// contact passes leave their slope contacts alone. Scratch of the step, not part of the state:
+  /// after the contact passes it holds the islands' marks (`WorldDef::sleep_islands`,
+  /// `update_motion_states`), and the next step clears it before a substep writes it.
   std::uint32_t* rolled;
   std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   std::uint32_t body_count = 0, pair_count = 0, plane_count = 0, shape_count = 0;
@@ -177,6 +179,19 @@ void wake(WorldData<D>& w, Body<D>& b)
   b.state = MotionState::moving;
   b.slow_time = 0;
   b.step_start = b.position;  // a sleeper is not integrated: this is where it started the step
+}
+
+/// Wakes a sleeper that an awake neighbour joins to its island (`WorldDef::sleep_islands`): as
+/// `wake`, but it keeps its still time, since nothing has moved it yet, and it is settling, not
+/// moving, so that with hull contacts it keeps its hull out of the ground (`hull_radius`) while
+/// the pile presses on it.
+template <int D>
+void join_island(WorldData<D>& w, Body<D>& b)
+{
+  const Scalar still = b.slow_time;
+  wake(w, b);
+  b.slow_time = still;
+  b.state = MotionState::settling;
 }
 
 /// True when the sleep test measures the body's centre from where its slow time began

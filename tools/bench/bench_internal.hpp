@@ -16,6 +16,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace statsim {
@@ -181,7 +182,16 @@ struct StatsimVariant {
   /// A 3D world compiled with every feature (`Features::all`) instead of the smallest set that
   /// covers the scene (statsim/features.hpp); the bits are the same either way.
   bool all_features = false;
+  /// WorldDef fields set by name after the ones above, in order (`world_setting_names()`): the
+  /// pile-model candidates of `statsim fidelity` ("statistical+shock_propagation=0").
+  std::vector<std::pair<std::string, double>> settings;
 };
+/// The WorldDef fields a `StatsimVariant::settings` entry may name, with the meaning of the
+/// value (booleans: 0 or 1).
+const std::vector<std::pair<std::string, std::string>>& world_setting_names();
+/// Throws std::invalid_argument naming the known fields when `name` is not one of them, or when
+/// `value` is not one the field takes.
+void check_world_setting(const std::string& name, double value);
 /// A statsim world with any signature (e.g. one loaded at run time); `sig`'s storage must outlive it.
 /// `walls`: static planes besides the ground (at most 7).
 std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mass, const scenes::DropScene3& scene,

@@ -20,6 +20,96 @@
 #include <utility>
 
 namespace statsim::tools::bench {
+
+namespace {
+
+/// One WorldDef field a pile-model candidate may set: its name, what the value means, and how it
+/// is written into a WorldDef of either dimension.
+struct WorldSetting {
+  const char* name;
+  const char* meaning;
+  bool integer_only;
+  double low, high;
+  void (*apply3)(WorldDef<3>&, double);
+  void (*apply2)(WorldDef<2>&, double);
+};
+
+#define STATSIM_SETTING(field, meaning, integer_only, low, high, cast)                            \
+  WorldSetting                                                                                     \
+  {                                                                                                \
+    #field, meaning, integer_only, low, high, [](WorldDef<3>& d, double v) { d.field = cast(v); }, \
+        [](WorldDef<2>& d, double v) { d.field = cast(v); }                                        \
+  }
+
+template <class T>
+T to(double v)
+{
+  return static_cast<T>(v);
+}
+
+const std::vector<WorldSetting>& world_settings()
+{
+  static const std::vector<WorldSetting> all = {
+      STATSIM_SETTING(support_iterations, "support passes, 1 to 64", true, 1, 64, to<int>),
+      STATSIM_SETTING(shock_propagation, "bottom-up shock pass, 0 or 1", true, 0, 1, to<bool>),
+      STATSIM_SETTING(position_iterations, "position passes, 0 to 64", true, 0, 64, to<int>),
+      STATSIM_SETTING(allowed_overlap, "overlap left, fraction of the touching distance", false, 0, 0.5, to<Scalar>),
+      STATSIM_SETTING(overlap_correction, "share of the overlap removed per step", false, 1e-6, 1, to<Scalar>),
+      STATSIM_SETTING(sleep_speed, "m/s", false, 0, 100, to<Scalar>),
+      STATSIM_SETTING(sleep_time, "s", false, 0, 100, to<Scalar>),
+      STATSIM_SETTING(settle_speed, "m/s", false, 0, 100, to<Scalar>),
+      STATSIM_SETTING(wake_speed, "m/s", false, 0, 100, to<Scalar>),
+      STATSIM_SETTING(restitution_threshold, "m/s", false, 0, 100, to<Scalar>),
+      STATSIM_SETTING(linear_damping, "1/s", false, 0, 1000, to<Scalar>),
+      STATSIM_SETTING(angular_damping, "1/s", false, 0, 1000, to<Scalar>),
+      STATSIM_SETTING(pile_rest, "0 or 1", true, 0, 1, to<bool>),
+      STATSIM_SETTING(sleep_islands, "0 or 1", true, 0, 1, to<bool>),
+  };
+  return all;
+}
+
+#undef STATSIM_SETTING
+
+const WorldSetting& find_setting(const std::string& name)
+{
+  for (const WorldSetting& s : world_settings())
+    if (name == s.name) return s;
+  std::string known;
+  for (const WorldSetting& s : world_settings()) known += std::string(known.empty() ? "" : ", ") + s.name;
+  throw std::invalid_argument("unknown WorldDef setting '" + name + "' (known: " + known + ")");
+}
+
+template <int D>
+void apply_settings(WorldDef<D>& def, const std::vector<std::pair<std::string, double>>& settings)
+{
+  for (const auto& [name, value] : settings) {
+    check_world_setting(name, value);
+    const WorldSetting& s = find_setting(name);
+    if constexpr (D == 3) s.apply3(def, value);
+    else s.apply2(def, value);
+  }
+}
+
+}  // namespace
+
+const std::vector<std::pair<std::string, std::string>>& world_setting_names()
+{
+  static const std::vector<std::pair<std::string, std::string>> names = [] {
+    std::vector<std::pair<std::string, std::string>> n;
+    for (const WorldSetting& s : world_settings()) n.emplace_back(s.name, s.meaning);
+    return n;
+  }();
+  return names;
+}
+
+void check_world_setting(const std::string& name, double value)
+{
+  const WorldSetting& s = find_setting(name);
+  if (!std::isfinite(value) || value < s.low || value > s.high || (s.integer_only && value != std::floor(value)))
+    throw std::invalid_argument("WorldDef setting " + name + "=" + std::to_string(value) + ": out of range (" +
+                                s.meaning + ")");
+}
+
 namespace {
 
 // Capacities: the world is sized to the scene (the smallest of these tiers that holds N), as a user
@@ -108,6 +198,7 @@ public:
     if (pool_) def.workers = pool_->workers();
     if (variant.independent_pairs) def.pair_response = PairResponse::independent;
     set_broad_phase(def.broad_phase, broad_phase);
+    apply_settings(def, variant.settings);
     world_ = std::make_unique<WorldT>(def);
     if (world_->construction_status() != Status::ok)
       throw std::runtime_error(std::string("statsim world: ") + to_string(world_->construction_status()));

@@ -73,10 +73,8 @@ double level_mean(const ConvergenceLevel& level, std::size_t m)
 double convergence_resolution(const SceneMetric& metric)
 {
   const std::string& n = metric.name;
-  if (n == "angle_deg") return 0.3;
-  if (n == "height" || n == "mean_radius" || n == "mean_height") return 0.01;
-  if (n == "fill_height" || n == "packing") return 0.005;
-  if (n == "held") return 0.002;
+  if (goal_tolerance(metric) > 0) return goal_tolerance(metric) / 10;
+  if (n == "mean_radius" || n == "mean_height") return 0.01;
   if (n == "overlap") return 0.1;
   if (n == "in_rest_pose") return 0.01;
   return 0.0;

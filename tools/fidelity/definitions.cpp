@@ -2,6 +2,8 @@
 // error and its goals, the definitions written into --help and the JSON.
 #include "fidelity/fidelity.hpp"
 
+#include <cmath>
+
 namespace statsim::tools::fidelity {
 
 namespace {
@@ -16,6 +18,36 @@ std::vector<SceneMetric> scene_metrics(const std::string& kind)
   if (kind == "heap") return {{"angle_deg", "deg", false}, {"height", "m", true}};
   if (kind == "bin") return {{"fill_height", "m", true}, {"packing", "", true}};
   return {{"held", "", false}, {"overlap", "mm", false}};
+}
+
+double goal_tolerance(const SceneMetric& metric)
+{
+  const std::string& n = metric.name;
+  if (n == "angle_deg") return 3.0;
+  if (n == "height") return 0.10;
+  if (n == "fill_height" || n == "packing") return 0.05;
+  if (n == "held") return 0.02;
+  return 0.0;
+}
+
+PileSummary pile_summary(const std::vector<SceneResult>& scenes, std::size_t m)
+{
+  PileSummary s;
+  double terms = 0, runs = 0;
+  for (const SceneResult& sc : scenes) {
+    if (m >= sc.methods.size() || (sc.kind != "heap" && sc.kind != "bin")) continue;
+    const SceneSample& x = sc.methods[m];
+    for (std::size_t k = 0; k < sc.metrics.size() && k < x.distances.size(); ++k) {
+      const double tol = goal_tolerance(sc.metrics[k]);
+      if (tol <= 0) continue;
+      s.pile_error += std::fabs(x.distances[k].value) / tol;
+      terms += 1;
+    }
+    for (const SceneRun& r : x.runs) s.step_ms += r.step_ms, runs += 1;
+  }
+  if (terms > 0) s.pile_error /= terms;
+  if (runs > 0) s.step_ms /= runs;
+  return s;
 }
 
 double summary_error(double rest_tvd, double rest_height_err, double travel_w1, double bounce_w1,

@@ -199,6 +199,9 @@ struct SceneRun {
   bool all_asleep = false;     ///< every body asleep at the end (the engine's sleep state)
   bool time_limited = false;   ///< heap, bin: not every body rested by the time limit
   double seconds = 0;          ///< simulated time of the run, s
+  /// Thread CPU time of the engine's steps over the run, ms per step (0: not measured, as in a
+  /// reference read back by --scene-reference from a file written before it was recorded).
+  double step_ms = 0;
 };
 
 /// A measurement of a scene and how its distance to the reference is taken.
@@ -209,6 +212,11 @@ struct SceneMetric {
 };
 /// The measurements of a scene kind (heap, bin, column, wall).
 std::vector<SceneMetric> scene_metrics(const std::string& kind);
+/// The distance a figure's goal allows, in its distance's unit (issue goals: angle of repose 3 deg,
+/// heap height 10%, bin fill height and packing 5%, a stack's held height 0.02); 0: the figure has
+/// no goal (a stack's overlap).
+double goal_tolerance(const SceneMetric& metric);
+
 
 /// One sample's runs of a scene and, for the methods, the distances to the reference sample A.
 struct SceneSample {
@@ -227,6 +235,16 @@ struct SceneResult {
   SceneSample reference, reference_b;
   std::vector<SceneSample> methods;
 };
+
+/// A pile model's summary over the heap and bin scenes run (the stacks have a summary of their
+/// own: their held height): the mean of |distance| / goal_tolerance over their figures (1: at the
+/// goals on average), and the thread CPU time per step of their runs, mean over the runs (ms).
+struct PileSummary {
+  double pile_error = 0;
+  double step_ms = 0;
+};
+/// The summary of method `m` (an index into each scene's methods).
+PileSummary pile_summary(const std::vector<SceneResult>& scenes, std::size_t m);
 
 struct FidelityResult {
   FidelityOptions options;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace statsim::tools::fidelity {
@@ -168,6 +169,40 @@ double measure_step_ms(const Setup& setup, const MethodSpec& m, int n, int steps
 
 namespace {
 
+/// The "+FIELD=VALUE" parts of a method's name, each checked (bench::check_world_setting).
+std::vector<std::pair<std::string, double>> world_settings_of(const std::string& method)
+{
+  std::vector<std::pair<std::string, double>> out;
+  std::size_t at = method.find('+');
+  while (at != std::string::npos) {
+    const std::size_t next = method.find('+', at + 1);
+    const std::string part = method.substr(at + 1, next == std::string::npos ? std::string::npos : next - at - 1);
+    const std::size_t eq = part.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == part.size())
+      throw std::invalid_argument("method " + method + ": '" + part + "' is not FIELD=VALUE");
+    const std::string field = part.substr(0, eq), text = part.substr(eq + 1);
+    std::size_t used = 0;
+    double value = 0;
+    try {
+      value = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != text.size()) throw std::invalid_argument("method " + method + ": '" + text + "' is not a number");
+    bench::check_world_setting(field, value);
+    out.emplace_back(field, value);
+    at = next;
+  }
+  return out;
+}
+
+std::string format_setting(double value)
+{
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", value);
+  return buf;
+}
+
 bench::Body3 body_from_mesh(const std::string& path, const SignatureView<3>& table)
 {
   TriMesh mesh;
@@ -242,9 +277,16 @@ Setup make_setup(const FidelityOptions& o)
 
   auto shapes = bench::make_bullet_shapes(s.body);
   auto mix_shapes = s.mixed ? bench::make_bullet_shapes(s.mix_body) : nullptr;
-  for (const std::string& name : names) {
+  for (const std::string& full_name : names) {
     MethodSpec m;
-    m.name = name;
+    m.name = full_name;
+    // "statistical+FIELD=VALUE+...": a statistical method with WorldDef fields set by name.
+    const std::string name = full_name.substr(0, full_name.find('+'));
+    const std::vector<std::pair<std::string, double>> settings = world_settings_of(full_name);
+    if (!settings.empty() && name != "statistical" && name != "statistical-norest" &&
+        name != "statistical-independent" && name != "statistical-spheres")
+      throw std::invalid_argument("method " + full_name + ": WorldDef settings (+FIELD=VALUE) go after statistical, "
+                                  "statistical-norest, statistical-independent or statistical-spheres");
     if (s.mixed && name.rfind("statistical:", 0) == 0) {
       if (o.methods.empty()) continue;
       throw std::invalid_argument("method " + name + ": --mix takes the compiled tables only");
@@ -277,6 +319,8 @@ Setup make_setup(const FidelityOptions& o)
                        : name == "statistical-independent" ? ", independent pair response"
                        : name == "statistical-spheres"     ? ", collision spheres between bodies (the library's default)"
                                                            : ", momentum pair response, resting conditions on");
+      m.variant.settings = settings;
+      for (const auto& [field, value] : settings) m.description += ", " + field + " = " + format_setting(value);
     } else if (name.rfind("statistical:", 0) == 0) {
       const std::string t = name.substr(12);
       auto it = std::find_if(s.loaded.begin(), s.loaded.end(), [&](const LoadedSignature3& l) { return l.name() == t; });

@@ -223,12 +223,16 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
   out.shapes = sc.shapes;
   out.run.time_limited = !stack;
   out.states.resize(n);
-  double t = 0;
+  double t = 0, step_cpu = 0;
+  long stepped = 0;
   std::size_t released = 0;  // heap: bodies are released in order
   for (long k = 1; k <= steps; ++k) {
     for (; released < sc.release.size() && sc.release_time[released] <= t + 1e-9; ++released)
       sim->place_body(released, sc.release[released]);
+    const double cpu = bench::thread_cpu_ms();
     sim->step();
+    step_cpu += bench::thread_cpu_ms() - cpu;
+    ++stepped;
     t = static_cast<double>(k) * dt;
     if (stack || released < sc.release.size()) continue;
     bool all = true;
@@ -247,6 +251,7 @@ SceneOutcome run_scene(const Setup& setup, const MethodSpec& m, const scenes::Pi
     }
   }
   out.run.seconds = t;
+  out.run.step_ms = stepped > 0 ? step_cpu / static_cast<double>(stepped) : 0.0;
   out.run.all_asleep = true;
   std::vector<Eigen::Vector3d> centres(n);
   out.asleep.resize(n);

@@ -21,6 +21,7 @@ std::vector<SceneRun> runs_of(const json& sample, const std::vector<SceneMetric>
     run.all_asleep = r.at("all_asleep").get<bool>();
     run.time_limited = r.at("time_limited").get<bool>();
     run.seconds = r.at("seconds").get<double>();
+    run.step_ms = r.value("step_ms", 0.0);
     out.push_back(std::move(run));
   }
   return out;
