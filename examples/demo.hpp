@@ -25,7 +25,17 @@ struct Options {
   int steps = 60 * 20;              ///< at most this many steps of 1/60 s
   unsigned long long seed = 1;
   bool stop_when_asleep = true;     ///< end the run early once every body sleeps
+  bool spheres = false;             ///< --spheres: bodies touch at their collision spheres (the paper's model)
 };
+
+/// The world's parameters of a demo: the defaults, the seed, and `--spheres`.
+inline WorldDef3 demo_def(const Options& o)
+{
+  WorldDef3 def;
+  def.seed = o.seed;
+  if (o.spheres) def.body_contacts = BodyContacts::collision_spheres;
+  return def;
+}
 
 inline bool parse(int argc, char** argv, Options& o, const char* usage)
 {
@@ -36,6 +46,7 @@ inline bool parse(int argc, char** argv, Options& o, const char* usage)
     else if (!std::strcmp(argv[i], "--every") && has) o.every = int(std::strtol(argv[++i], nullptr, 10));
     else if (!std::strcmp(argv[i], "--steps") && has) o.steps = int(std::strtol(argv[++i], nullptr, 10));
     else if (!std::strcmp(argv[i], "--seed") && has) o.seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--spheres")) o.spheres = true;
     else {
       std::fprintf(stderr, "usage: %s\n", usage);
       return false;
@@ -127,14 +138,13 @@ struct DropDemo {
 inline int drop_main(int argc, char** argv, WorldCore3& w, const DropDemo& d)
 {
   char usage[160];
-  std::snprintf(usage, sizeof usage, "%s [--n N<=%u] [--frames FILE.csv] [--every K] [--steps S] [--seed S]", d.name,
-                w.body_capacity());
+  std::snprintf(usage, sizeof usage, "%s [--n N<=%u] [--frames FILE.csv] [--every K] [--steps S] [--seed S] [--spheres]",
+                d.name, w.body_capacity());
   Options o;
   o.n = d.drop.count;
   if (!parse(argc, argv, o, usage)) return 2;
   if (o.n < 1 || o.n > long(w.body_capacity())) return 2;
-  WorldDef3 def;
-  def.seed = o.seed;
+  const WorldDef3 def = demo_def(o);
   tools::scenes::CylinderDrop drop = d.drop;
   drop.count = o.n;
   ShapeId shape{};

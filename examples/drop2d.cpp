@@ -2,7 +2,7 @@
 // signatures from the committed tables (tables/square2d.hpp, tables/lshape2d.hpp). Prints a
 // summary and writes a PNG of the final frame. Bodies touch at their hulls (the tables' body-body
 // data, `BodyContacts::hulls`), so they pile as polygons do instead of resting on one another's
-// collision spheres; --spheres gives the paper's model, the library's default.
+// collision spheres; --spheres gives the paper's model.
 //
 //   drop2d [--n N] [--png FILE] [--seed S] [--frames FILE.csv] [--every K] [--spheres]
 //     --n       bodies of each shape (default 100, at most 500)
@@ -127,7 +127,7 @@ int main(int argc, char** argv)
 
   WorldDef2 def;
   def.seed = seed;
-  def.body_contacts = spheres ? BodyContacts::collision_spheres : BodyContacts::hulls;
+  if (spheres) def.body_contacts = BodyContacts::collision_spheres;  // else the default: hulls
   bool set_up = world.configure(def) == Status::ok;
   const SignatureView<2> signatures[2] = {tables::square2d.view(), tables::lshape2d.view()};
   const Outline outlines[2] = {centred(square_outline, 4), centred(lshape_corners, 6)};

@@ -27,8 +27,12 @@ int main(int argc, char** argv)
       argc -= 2;
       break;
     }
-  if (!demo::parse(argc, argv, o, "rest_conditions [--seed S] [--frames FILE.csv] [--frames-without FILE.csv]"))
+  const char* usage = "rest_conditions [--seed S] [--frames FILE.csv] [--frames-without FILE.csv]";
+  if (!demo::parse(argc, argv, o, usage)) return 2;
+  if (o.spheres) {  // one body: nothing touches it, so --spheres would change nothing
+    std::fprintf(stderr, "usage: %s\n", usage);
     return 2;
+  }
   const statsim::SignatureView<3> sig = statsim::tables::bunny.view();
   for (int k = 0; k < 2; ++k) {
     statsim::WorldDef3 def;

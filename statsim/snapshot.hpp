@@ -70,7 +70,7 @@ inline bool removed_slot(const BodySlots& s, std::uint32_t slot) { return !s.liv
 template <int D>
 bool keeps_step_start(const WorldData<D>& w, const Body<D>& b)
 {
-  return b.state != MotionState::asleep && b.slow_time != 0 && w.def.body_contacts == BodyContacts::hulls &&
+  return b.state != MotionState::asleep && b.slow_time != 0 && hull_contacts_on(w) &&
          sleeps_from_anchor(w, b);
 }
 
@@ -114,7 +114,7 @@ bool read_def(SnapshotReader& in, WorldDef<D>& d)
   std::uint8_t b[9];
   for (std::uint8_t& x : b) x = in.u8();
   for (int i = 0; i < 7; ++i)
-    if (b[i] > 1) return false;
+    if (b[i] > (i == 4 ? 2 : 1)) return false;  // b[4]: BodyContacts, up to `automatic`
   if (b[7] > 2 || b[8] > 1) return false;
   d.table_restitution_threshold = b[0] != 0;
   d.shock_propagation = b[1] != 0;

@@ -203,8 +203,12 @@ enum class BodyContacts : std::uint8_t {
   /// map and largest faces) times the shape's packing ratio from reference piles, along the
   /// candidate contact normal that allows the least; for pairs whose tables both have
   /// body-body data (a plain sphere counts as having it), else as `collision_spheres`.
-  /// Settling bodies also keep their hull out of planes.
+  /// Settling bodies also keep their hull out of planes. Refused by a world compiled without
+  /// `Features::hull_contacts`.
   hulls,
+  /// `hulls` in a world compiled with `Features::hull_contacts`, else `collision_spheres`: the
+  /// model a scene's feature set declares (the default).
+  automatic,
 };
 
 /// Parameters of a world. Defaults suit bodies of 5 cm to 1 m at 30 to 240 Hz.
@@ -246,13 +250,13 @@ struct WorldDef {
   Scalar wake_speed = Scalar(0.5);
   /// Bodies fall asleep by islands (bodies connected through touching pairs), as rigid-body
   /// engines put them to sleep: a body still for `sleep_time` waits until every awake body it
-  /// touches, directly or through others, is too, and they fall asleep in the same step; an
-  /// awake body that is not yet still wakes a sleeper it touches at any approach speed. Off (the
-  /// default): each body falls asleep on its own, and a sleeper is a static support unless hit
-  /// faster than `wake_speed`. A pile then freezes layer by layer as it forms, where a pile of
-  /// rigid bodies slumps under the bodies still landing on it (tools/fidelity/README.md, "A pile
-  /// model").
-  bool sleep_islands = false;
+  /// touches, directly or through others, is too, and they fall asleep in the same step; at the
+  /// end of a step an awake body that was not still in it joins a sleeper it touches to its
+  /// island, at any approach speed (the default). Off: each body falls asleep on its own, and a sleeper is a static support unless
+  /// hit faster than `wake_speed`; a pile then freezes layer by layer as it forms, where a pile
+  /// of rigid bodies slumps under the bodies still landing on it (tools/fidelity/README.md, "A
+  /// pile model").
+  bool sleep_islands = true;
   /// Velocity damping, 1/s: v *= 1 / (1 + dt c). 0 = none.
   Scalar linear_damping = 0;
   /// Spin damping, 1/s. 0 = none.
@@ -283,11 +287,13 @@ struct WorldDef {
   /// samples made to conserve momentum (the default: in piles the independent responses add
   /// energy, see statsim/README.md, "Statistical bodies").
   PairResponse pair_response = PairResponse::momentum;
-  /// Where bodies touch each other: at their collision spheres (default, the paper's rule), or at
-  /// their hulls for tables with body-body data. Hulls hold stacks at their true height and keep
-  /// bodies out of the ground; they are not the default yet because a few bodies of a large
-  /// L-shape pile then stay awake (statsim/README.md, "Statistical bodies").
-  BodyContacts body_contacts = BodyContacts::collision_spheres;
+  /// Where bodies touch each other: at their hulls for tables with body-body data wherever the
+  /// world compiles hull contacts (`automatic`, the default), always at their collision spheres
+  /// (the paper's rule), or at their hulls (refused without `Features::hull_contacts`). Hulls
+  /// hold stacks at their true height and keep bodies out of the ground; collision spheres take
+  /// a third of their time per step in piles and stand piles too tall (statsim/README.md,
+  /// "Statistical bodies"; tools/fidelity/README.md, "One default").
+  BodyContacts body_contacts = BodyContacts::automatic;
   /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
   bool rest_conditions = true;
   /// Bodies settling on other bodies (not on the ground) blend their radius to the shape's

@@ -5,6 +5,7 @@
 #include "bullet/drop_world.hpp"
 #include "scenes/piles.hpp"
 #include "scenes/scenes.hpp"
+#include "statsim/detail/state_hash.hpp"
 #include "statsim/signature.hpp"
 
 #include <doctest/doctest.h>
@@ -407,4 +408,28 @@ TEST_CASE("bench: in a mixed world each body has its own shape (statsim and Bull
   CHECK_THROWS(bench::make_statsim3_mixed({box_sig, bunny_sig}, {box.mass, bunny.mass}, {0}, scene, 1, 1.0 / 60.0, {}));
   CHECK_THROWS(bench::make_bullet_mixed({bench::make_bullet_shapes(box)}, {0, 1}, "full", settings, scene.bodies,
                                         1.0 / 240.0));
+}
+
+TEST_CASE("bench: statsim's worlds run the library's default model, and --body-contacts spheres the paper's")
+{
+  // One default everywhere (tools/fidelity/README.md, "One default"): the bench's and the
+  // fidelity tool's worlds take `WorldDef`'s defaults but for the seed, so a default changed in
+  // the runtime is the default they measure. Compared through the hash of every parameter.
+  const auto def_hash = [](const auto& def) {
+    statsim::detail::Fnv1a h;
+    statsim::detail::hash_def(h, def);
+    return h.value;
+  };
+  const bench::StatsimVariant by_default;
+  statsim::WorldDef<3> library3;
+  library3.seed = 11;
+  statsim::WorldDef<2> library2;
+  library2.seed = 11;
+  CHECK(def_hash(bench::statsim_world_def<3>(11, "", by_default)) == def_hash(library3));
+  CHECK(def_hash(bench::statsim_world_def<2>(11, "", by_default)) == def_hash(library2));
+  bench::StatsimVariant spheres;
+  spheres.hull_contacts = false;
+  const statsim::WorldDef<3> paper = bench::statsim_world_def<3>(11, "", spheres);
+  CHECK(paper.body_contacts == statsim::BodyContacts::collision_spheres);
+  CHECK(def_hash(paper) != def_hash(library3));
 }

@@ -274,6 +274,7 @@ TEST_CASE("at collision spheres both broad phases look as far as the spheres and
       WorldDef3 def;
       def.gravity = Vector3::Zero();
       def.broad_phase = bp;
+      def.body_contacts = BodyContacts::collision_spheres;
       auto world = std::make_unique<World3<300, 8, 3000>>(def);
       ShapeDef large, small;
       large.radius = 0.15f;

@@ -66,6 +66,8 @@ TEST_CASE("features: a scene hashes the same under every feature set that covers
   // Collision spheres on level ground: `paper` covers it, and so do the larger sets.
   WorldDef3 d3;
   WorldDef2 d2;
+  d3.body_contacts = BodyContacts::collision_spheres;
+  d2.body_contacts = BodyContacts::collision_spheres;
   const auto all3 = std::make_unique<Small3<Features::all>>();
   const std::uint64_t h3 = drop_scene<3>(*all3, tables::box, d3, false);
   CHECK(drop_scene<3>(*std::make_unique<Small3<Features::paper>>(), tables::box, d3, false) == h3);
@@ -73,14 +75,33 @@ TEST_CASE("features: a scene hashes the same under every feature set that covers
   CHECK(drop_scene<3>(*std::make_unique<Small3<Features::paper | Features::slopes>>(), tables::box, d3, false) == h3);
   const std::uint64_t h2 = drop_scene<2>(*std::make_unique<Small2<Features::all>>(), tables::square2d, d2, false);
   CHECK(drop_scene<2>(*std::make_unique<Small2<Features::paper>>(), tables::square2d, d2, false) == h2);
-  // Hull contacts: `piles`.
-  d3.body_contacts = BodyContacts::hulls;
-  d2.body_contacts = BodyContacts::hulls;
-  const std::uint64_t p3 = drop_scene<3>(*std::make_unique<Small3<Features::all>>(), tables::box, d3, false);
-  CHECK(p3 != h3);
-  CHECK(drop_scene<3>(*std::make_unique<Small3<Features::piles>>(), tables::box, d3, false) == p3);
-  const std::uint64_t p2 = drop_scene<2>(*std::make_unique<Small2<Features::all>>(), tables::square2d, d2, false);
-  CHECK(drop_scene<2>(*std::make_unique<Small2<Features::piles>>(), tables::square2d, d2, false) == p2);
+  // Hull contacts, asked for or by default (`automatic`): `piles`.
+  for (const BodyContacts contacts : {BodyContacts::hulls, BodyContacts::automatic}) {
+    CAPTURE(int(contacts));
+    d3.body_contacts = contacts;
+    d2.body_contacts = contacts;
+    const std::uint64_t p3 = drop_scene<3>(*std::make_unique<Small3<Features::all>>(), tables::box, d3, false);
+    CHECK(p3 != h3);
+    CHECK(drop_scene<3>(*std::make_unique<Small3<Features::piles>>(), tables::box, d3, false) == p3);
+    const std::uint64_t p2 = drop_scene<2>(*std::make_unique<Small2<Features::all>>(), tables::square2d, d2, false);
+    CHECK(drop_scene<2>(*std::make_unique<Small2<Features::piles>>(), tables::square2d, d2, false) == p2);
+  }
+  // The default in a world without hull contacts: the bodies step as with collision spheres (the
+  // hash differs by the parameter alone).
+  {
+    d3.body_contacts = BodyContacts::automatic;
+    const auto by_default = std::make_unique<Small3<Features::paper>>();
+    drop_scene<3>(*by_default, tables::box, d3, false);
+    d3.body_contacts = BodyContacts::collision_spheres;
+    const auto spheres = std::make_unique<Small3<Features::paper>>();
+    drop_scene<3>(*spheres, tables::box, d3, false);
+    REQUIRE(by_default->body_count() == spheres->body_count());
+    for (std::uint32_t i = 0; i < spheres->body_count(); ++i) {
+      CHECK(by_default->body(i).position == spheres->body(i).position);
+      CHECK(by_default->body(i).orientation.coeffs() == spheres->body(i).orientation.coeffs());
+    }
+    d3.body_contacts = BodyContacts::hulls;
+  }
   // A tilted floor: `paper | slopes`, with and without hull contacts.
   const std::uint64_t s3 = drop_scene<3>(*std::make_unique<Small3<Features::all>>(), tables::box, d3, true);
   CHECK(drop_scene<3>(*std::make_unique<Small3<Features::piles | Features::slopes>>(), tables::box, d3, true) == s3);
@@ -133,11 +154,13 @@ TEST_CASE("features: a world refuses what its features leave out, changing nothi
     def.body_contacts = BodyContacts::hulls;
     const auto refused = std::make_unique<Small3<Features::paper>>(def);
     CHECK(refused->construction_status() == Status::not_compiled);
-    CHECK(refused->def().body_contacts == BodyContacts::collision_spheres);
+    CHECK(refused->def().body_contacts == BodyContacts::automatic);  // the default, kept
     CHECK(refused->configure(def) == Status::not_compiled);
-    CHECK(refused->def().body_contacts == BodyContacts::collision_spheres);
+    CHECK(refused->def().body_contacts == BodyContacts::automatic);
     const auto accepted = std::make_unique<Small3<Features::piles>>(def);
     CHECK(accepted->construction_status() == Status::ok);
+    // The default asks for no feature: without hull contacts it means collision spheres.
+    CHECK(std::make_unique<Small3<Features::paper>>()->construction_status() == Status::ok);
   }
   SUBCASE("tilted planes, and a gravity that tilts a plane")
   {

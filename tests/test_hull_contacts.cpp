@@ -251,7 +251,9 @@ TEST_CASE("hull contacts: a 2D pile of squares and L-shapes ends asleep, above t
 TEST_CASE("hull contacts: 2D piles of squares end asleep and above the ground")
 {
   // Twelve piles of 100 squares: a square wedged between neighbours that slides along one and is
-  // pushed back by another, every few steps, must still fall asleep.
+  // pushed back by another, every few steps, must still fall asleep, within 25 s (sleeping by
+  // islands, the default, a square tipping slowly off an edge keeps its island awake until it
+  // rests: seed 7's last one at 16 s).
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
     CAPTURE(seed);
     WorldDef2 def;
@@ -268,10 +270,9 @@ TEST_CASE("hull contacts: 2D piles of squares end asleep and above the ground")
       b.orientation = Rot2::from_angle(Scalar(6.283185) * rng.uniform());
       REQUIRE(w->add_body(b).status == Status::ok);
     }
-    for (int s = 0; s < 900; ++s) REQUIRE(w->step(Scalar(1) / 60).ok());
-    std::uint32_t asleep = 0;
-    for (std::uint32_t i = 0; i < w->body_count(); ++i) asleep += w->body(i).state == MotionState::asleep ? 1u : 0u;
-    CHECK(asleep == w->body_count());
+    for (int s = 0; s < 1500 && w->count(MotionState::asleep) < w->body_count(); ++s)
+      REQUIRE(w->step(Scalar(1) / 60).ok());
+    CHECK(w->count(MotionState::asleep) == w->body_count());
     Scalar overlap, lowest;
     pile_state<2>(*w, overlap, lowest);
     CHECK(lowest > Scalar(-0.01));

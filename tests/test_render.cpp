@@ -324,6 +324,7 @@ TEST_CASE("reference-run: statsim with hull contacts runs the same scene, touchi
 {
   statsim::testing::TempDir dir("reference-run");
   render::ReferenceRunOptions o = run_options("bunnies12", "statsim", dir.file("spheres.csv"));
+  o.hull_contacts = false;  // --body-contacts spheres; the default is the library's, hulls
   o.seconds = 3.0;
   o.every = 120;
   std::string error;
@@ -345,14 +346,14 @@ TEST_CASE("reference-run: statsim with hull contacts runs the same scene, touchi
   CHECK(spheres != hulls);
 }
 
-TEST_CASE("reference-run: hull contacts are refused for Bullet, and nothing is written")
+TEST_CASE("reference-run: statsim's body contacts are refused for Bullet, and nothing is written")
 {
   statsim::testing::TempDir dir("reference-run");
   render::ReferenceRunOptions o = run_options("bunnies3", "bullet", dir.file("bullet.csv"));
-  o.hull_contacts = true;
+  o.hull_contacts = false;
   std::string error;
   CHECK_FALSE(render::reference_run(o, error));
-  CHECK(error.find("--hull-contacts") != std::string::npos);
+  CHECK(error.find("--body-contacts") != std::string::npos);
   CHECK_FALSE(std::ifstream(o.frames).good());
 }
 

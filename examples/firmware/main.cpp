@@ -11,10 +11,11 @@
 // FIRMWARE_SHAPE (0 box, 1 L-shape, 2 bunny), FIRMWARE_I16 (1: response tables as 16-bit
 // integers, quantised at compile time by `statsim::quantize16`, the rule of `statsim gather --precision i16`).
 // FIRMWARE_SNAPSHOT (1; 0 for the footprint variants): the snapshot round trip below.
-// FIRMWARE_FEATURES (0: `Features::all`, the default; 1: `Features::paper`, the smallest set that
-// covers these scenes): what the worlds' steps are compiled with (statsim/features.hpp); the
-// hashes are the same either way. FIRMWARE_ONLY3 (0; 1 needs FIRMWARE_SNAPSHOT=0): the 3D world
-// alone, as a program that steps one scene of one shape would be.
+// FIRMWARE_FEATURES (0: `Features::all`, the default; 1: `Features::piles`, the smallest set that
+// covers these scenes with the library's default hull contacts): what the worlds' steps are
+// compiled with (statsim/features.hpp); the hashes are the same either way. FIRMWARE_ONLY3 (0; 1
+// needs FIRMWARE_SNAPSHOT=0): the 3D world alone, as a program that steps one scene of one shape
+// would be.
 // FIRMWARE_TRACE (defined): also print the hash after every step. STATSIM_FIRMWARE is defined by
 // the Cortex-M build, STATSIM_WEB by the WebAssembly build.
 //
@@ -77,9 +78,9 @@
 #if FIRMWARE_FEATURES == 0
 #define FIRMWARE_FEATURE_SET statsim::Features::all
 #elif FIRMWARE_FEATURES == 1
-#define FIRMWARE_FEATURE_SET statsim::Features::paper
+#define FIRMWARE_FEATURE_SET statsim::Features::piles
 #else
-#error "FIRMWARE_FEATURES must be 0 (all) or 1 (paper)"
+#error "FIRMWARE_FEATURES must be 0 (all) or 1 (piles)"
 #endif
 
 #include <cstdint>
@@ -115,11 +116,11 @@ namespace {
 constexpr std::uint32_t bodies = FIRMWARE_BODIES;
 constexpr int steps = FIRMWARE_STEPS;
 constexpr statsim::Scalar dt = statsim::Scalar(1) / 60;
-// Candidate pairs per body (the broad phase pairs the collision spheres and a margin,
-// `detail::pair_radius`), each shape's measured peak with a margin of a third or more
+// Candidate pairs per body (with the default hull contacts the broad phase pairs the bounding
+// spheres, `detail::pair_radius`), each shape's measured peak with a margin of a third or more
 // (examples/firmware/README.md). A step reports an overflow, and this program then fails.
-constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 0 ? 3 : 2) * bodies;
-constexpr std::uint32_t pairs2 = 5 * bodies / 2;
+constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 0 ? 25 * bodies / 4 : (FIRMWARE_SHAPE == 1 ? 7 : 11) * bodies);
+constexpr std::uint32_t pairs2 = 7 * bodies / 2;
 // Scenes that grow with the body count: columns of bodies four high in 3D (k x k columns, k a
 // multiple of 4) and eight high in 2D.
 constexpr std::uint32_t grid_side(std::uint32_t n, std::uint32_t height, std::uint32_t step, std::uint32_t power)

@@ -333,7 +333,7 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   // loop costs it more than the count is worth.
   std::uint32_t found = 0;
   // With hull contacts every pair radius is the bounding radius where every shape has a hull.
-  bool bounding = FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls;
+  bool bounding = FS::hull_contacts && hull_contacts_on(w);
   for (std::uint32_t k = 0; k < w.shape_count; ++k) bounding = bounding && has_hull(w.shapes[k]);
   const Scalar common_reach = common + common;
   const Scalar common_reach2 = common_reach * common_reach;

@@ -26,7 +26,11 @@ Status check_world_def(const WorldDef<D>& d)
       d.wake_speed < 0 || d.linear_damping < 0 || d.angular_damping < 0 || d.support_iterations < 1 ||
       d.support_iterations > 64 || d.position_iterations < 0 || d.position_iterations > 64 ||
       (d.broad_phase != BroadPhase::grid && d.broad_phase != BroadPhase::sweep_and_prune &&
-       d.broad_phase != BroadPhase::automatic) || d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
+       d.broad_phase != BroadPhase::automatic) ||
+      (d.body_contacts != BodyContacts::collision_spheres && d.body_contacts != BodyContacts::hulls &&
+       d.body_contacts != BodyContacts::automatic) ||
+      (d.pair_response != PairResponse::independent && d.pair_response != PairResponse::momentum) ||
+      d.allowed_overlap < 0 || d.allowed_overlap >= Scalar(0.5) ||
       !(d.overlap_correction > 0) || d.overlap_correction > 1 || !(d.rest_blend_time > 0) ||
       !(d.rest_turn_time > 0) || d.ground_cosine < 0 || d.ground_cosine > 1 || d.rest_snap_cosine < 0 ||
       d.rest_snap_cosine > 1 || d.spin_ratio_speed_floor < 0 || d.sweep_axis < 0 || d.sweep_axis >= D ||

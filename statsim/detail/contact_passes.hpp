@@ -346,15 +346,11 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext<FS>& ctx)
       // An awake body hitting a sleeper fast enough, or pressed deep into its hull, wakes it;
       // otherwise the sleeper is static.
       const Scalar approach = (a.linear_velocity - b.linear_velocity).dot(n);
+      // (With `WorldDef::sleep_islands` a slower awake body joins the sleeper to its island at
+      // the end of the step: `join_islands`.)
       if (approach > def.wake_speed || wakes_by_overlap<FS>(w, a, b, c.depth, reach)) {
         if (a_asleep) wake(w, a);
         if (b_asleep) wake(w, b);
-      } else if (def.sleep_islands && (a_asleep ? b : a).slow_time == 0 && !(a_asleep && b_asleep)) {
-        // With islands (`WorldDef::sleep_islands`) an awake body that was not still in the last
-        // step joins the sleeper to its island, which sleeps once all of it is still. The sleeper
-        // keeps its still time: it wakes others only once it is pushed, and falls asleep again
-        // within `island_wait` sleep times of stillness even if a neighbour never comes to rest.
-        join_island(w, a_asleep ? a : b);
       }
     }
     Scalar ima, imb;

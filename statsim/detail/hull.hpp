@@ -290,7 +290,7 @@ bool hull_pair(const WorldData<D>& w, const Body<D>& a, const Body<D>& b)
 {
   const Shape<D>& sa = w.shapes[a.shape];
   const Shape<D>& sb = w.shapes[b.shape];
-  return FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && has_hull(sa) && has_hull(sb) &&
+  return FS::hull_contacts && hull_contacts_on(w) && has_hull(sa) && has_hull(sb) &&
          (sa.statistical || sb.statistical);
 }
 

@@ -21,7 +21,7 @@ std::uint32_t integrate(WorldData<D>& w, Scalar dt, Own&& own)
   const Vec dv = w.def.gravity * dt;
   const Scalar lin_damp = Scalar(1) / (1 + dt * w.def.linear_damping);
   const Scalar ang_damp = Scalar(1) / (1 + dt * w.def.angular_damping);
-  const bool hulls = FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls;
+  const bool hulls = FS::hull_contacts && hull_contacts_on(w);
   std::uint32_t count = 0;
   for_each_set(w.awake, w.body_count, [&](std::uint32_t i) {
     Body<D>& b = w.bodies[i];

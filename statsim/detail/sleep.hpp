@@ -128,6 +128,9 @@ template <class FS, int D>
 void fall_asleep(WorldData<D>& w, Body<D>& b, std::uint32_t i, bool posed, const typename Space<D>::Vec& ground)
 {
   using Vec = typename Space<D>::Vec;
+  // Where the centre stood above the ground: `hull_radius` of the body as it was, settling (the
+  // collision radius, or the hull's support where that is more); asleep it would be the radius.
+  const Scalar above = b.rest_pose != no_rest_pose && b.on_ground && posed ? hull_radius<FS>(w, b, ground) : Scalar(0);
   b.state = MotionState::asleep;
   clear_bit(w.awake, i);
   --w.awake_count;
@@ -136,11 +139,9 @@ void fall_asleep(WorldData<D>& w, Body<D>& b, std::uint32_t i, bool posed, const
   b.angular_velocity = Space<D>::zero_spin();
   if (b.rest_pose != no_rest_pose && b.on_ground && posed) {
     // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
-    // the radius blend are below what a slow body would show.
-    // The centre stood `hull_radius` above the ground (the collision radius, or the hull's
-    // support where that is more): it ends at the pose's height above it.
+    // the radius blend are below what a slow body would show. The centre stood `above` the
+    // ground: it ends at the pose's height above it.
     const SignatureView<D>& sig = w.shapes[b.shape].signature;
-    const Scalar above = hull_radius<FS>(w, b, ground);
     b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
     const Scalar h = sig.rest.heights[b.rest_pose];
     b.position += ground * (h - above);
@@ -148,10 +149,6 @@ void fall_asleep(WorldData<D>& w, Body<D>& b, std::uint32_t i, bool posed, const
     b.rest_blend = 1;
   }
 }
-
-/// With `WorldDef::sleep_islands`, sleep times after which a still body falls asleep whatever its
-/// island does (a still body out of its pose needs 3).
-constexpr Scalar island_wait = 4;
 
 /// `WorldDef::sleep_islands`: of the awake bodies marked ready in `ready` (still for their sleep
 /// time), unmarks every one connected to an unmarked awake body through the first `touching`
@@ -189,6 +186,23 @@ void sleep_islands(WorldData<D>& w, std::uint32_t* ready, std::uint32_t touching
     const bool posed = b.rest_pose == no_rest_pose || !b.on_ground || in_rest_pose(w, b, ground);
     fall_asleep<FS>(w, b, i, posed, ground);
   });
+}
+
+/// `WorldDef::sleep_islands`: after the step's sleep tests, each sleeper of the first `touching`
+/// pairs whose neighbour is awake and was not still in the step joins that neighbour's island
+/// (`joins_island`): it wakes for the next step, whose broad phase then finds its pairs with
+/// other sleepers. Joined in the contact passes it would move in this step without them (the
+/// broad phase skipped pairs of two sleepers), into whichever sleeper lies in its way; here it has
+/// been a static support for one step.
+template <int D>
+void join_islands(WorldData<D>& w, std::uint32_t touching)
+{
+  for (std::uint32_t k = 0; k < touching; ++k) {
+    Body<D>& a = w.bodies[w.pairs[k].a];
+    Body<D>& b = w.bodies[w.pairs[k].b];
+    if (joins_island(w, a, b)) join_island(w, b);
+    else if (joins_island(w, b, a)) join_island(w, a);
+  }
 }
 
 /// The last phase of a step: each awake body is moving, settling (touching and slower than
@@ -268,7 +282,10 @@ void update_motion_states(WorldData<D>& w, Scalar dt, std::uint32_t touching)
     if (!ready || b.slow_time >= island_wait * def.sleep_time) fall_asleep<FS>(w, b, i, posed, ground);
     else if (turning || b.rest_pose == no_rest_pose) set_bit(ready, i);
   });
-  if (ready) sleep_islands<FS>(w, ready, touching);
+  if (ready) {
+    sleep_islands<FS>(w, ready, touching);
+    join_islands(w, touching);
+  }
 }
 
 }  // namespace detail

@@ -74,7 +74,7 @@ Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
   const Shape<D>& s = w.shapes[b.shape];
   if (slope_hull<FS>(w, b, n))
     return support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
-  if (!FS::hull_contacts || w.def.body_contacts != BodyContacts::hulls || b.state != MotionState::settling || !s.statistical ||
+  if (!(FS::hull_contacts && hull_contacts_on(w)) || b.state != MotionState::settling || !s.statistical ||
       !s.signature.contact.present())
     return b.radius;
   const Scalar hull = support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
@@ -89,7 +89,7 @@ Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& pla
   // `hull_radius`'s first tests, before the plane's distance: every body meets every plane in
   // every pass, and most need neither.
   const bool slopes = FS::slopes && w.tilted_planes;
-  const bool hulls = FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && b.state == MotionState::settling;
+  const bool hulls = FS::hull_contacts && hull_contacts_on(w) && b.state == MotionState::settling;
   if (!slopes && !hulls) return b.radius;
   if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
   return hull_radius<FS>(w, b, plane.normal);

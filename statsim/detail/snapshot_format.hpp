@@ -17,7 +17,8 @@ namespace detail {
 constexpr std::uint32_t snapshot_magic = 0x4e535453u;
 /// Version of the snapshot layout; `load` refuses others with `snapshot_incompatible`.
 /// 2: `WorldDef::sleep_islands` follows the broad phase.
-constexpr std::uint16_t snapshot_version = 2;
+/// 3: `WorldDef::body_contacts` may be `automatic` (2), the default.
+constexpr std::uint16_t snapshot_version = 3;
 
 /// FNV-1a, 64 bits, of `n` bytes: the snapshot's checksum.
 inline std::uint64_t fnv1a64(const unsigned char* p, std::size_t n)

@@ -26,7 +26,8 @@ void hash_def(Fnv1a& h, const WorldDef<D>& d)
             std::uint8_t(d.pair_response), std::uint8_t(d.rest_conditions), std::uint8_t(d.pile_rest),
             d.rest_blend_time, d.rest_turn_time, d.rest_snap_cosine, d.ground_cosine, std::uint8_t(d.broad_phase),
             d.grid_above_bodies, std::int32_t(d.sweep_axis), std::uint8_t(d.table_restitution_threshold));
-  // Added only when not the default, so that worlds from before the option keep their hashes.
+  // Added only when not the value of before the option (collision spheres, islands off), so
+  // that worlds from before it keep their hashes.
   if (d.body_contacts != BodyContacts::collision_spheres) h.add(std::uint8_t(d.body_contacts));
   if (d.impact_threshold != WorldDef<D>{}.impact_threshold) h.add(d.impact_threshold);
   if (d.sleep_islands) h.add(std::uint8_t(0x51));

@@ -204,7 +204,7 @@ Scalar tip_over(const Shape<D>& shape, Body<D>& b, const typename Space<D>::Vec&
 template <class FS, int D>
 bool tip_gravity(const WorldData<D>& w, typename Space<D>::Vec& unit, Scalar& magnitude)
 {
-  if (!FS::hull_contacts || w.def.body_contacts != BodyContacts::hulls) return false;
+  if (!(FS::hull_contacts && hull_contacts_on(w))) return false;
   magnitude = w.def.gravity.norm();
   if (!(magnitude > 0)) return false;
   unit = w.def.gravity / magnitude;

@@ -59,7 +59,7 @@ template <class FS, int D>
 bool search_witnesses_first(WorldData<D>& w)
 {
 #if STATSIM_WORKERS
-  if (!FS::hull_contacts || w.def.workers.count < 2 || w.def.body_contacts != BodyContacts::hulls || !w.def.shock_propagation ||
+  if (!(FS::hull_contacts && hull_contacts_on(w)) || w.def.workers.count < 2 || !w.def.shock_propagation ||
       w.pair_count < 2 * witnesses_per_part)
     return false;
   run_on_workers(w, w.pair_count, witnesses_per_part, &search_witnesses<FS, D>, &w);

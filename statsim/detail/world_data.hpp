@@ -123,6 +123,17 @@ bool has_hull(const Shape<D>& s)
   return !s.statistical || s.signature.contact.present();
 }
 
+/// True when bodies meet at their hulls where both tables have body-body data: `BodyContacts::hulls`,
+/// or `automatic` in a world compiled with `Features::hull_contacts` (a world without it refuses
+/// `hulls`). The step's code tests its feature set first, `FS::hull_contacts && hull_contacts_on(w)`:
+/// a constant, so that a step compiled without hull contacts has none of their code even where
+/// nothing is inlined (tests/api/features_code.cmake).
+template <int D>
+bool hull_contacts_on(const WorldData<D>& w)
+{
+  return includes(w.features, Features::hull_contacts) && w.def.body_contacts != BodyContacts::collision_spheres;
+}
+
 /// How far beyond its collision sphere, as a fraction of its radius, the broad phase looks for a
 /// body's contacts. The step's passes move bodies after the broad phase (out of the ground, out of
 /// one another), and a pair they bring into touch is met in that step only if it is a candidate.
@@ -137,7 +148,7 @@ template <class FS = AllFeatures, int D>
 Scalar pair_radius(const WorldData<D>& w, const Body<D>& b)
 {
   const Shape<D>& s = w.shapes[b.shape];
-  if (FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && has_hull(s)) return s.bounding_radius;
+  if (FS::hull_contacts && hull_contacts_on(w) && has_hull(s)) return s.bounding_radius;
   const Scalar r = b.radius * (1 + pair_margin);
   return r < s.bounding_radius ? r : s.bounding_radius;
 }
@@ -181,6 +192,23 @@ void wake(WorldData<D>& w, Body<D>& b)
   b.step_start = b.position;  // a sleeper is not integrated: this is where it started the step
 }
 
+/// With `WorldDef::sleep_islands`, sleep times after which a still body falls asleep whatever its
+/// island does (a still body out of its pose needs 3).
+constexpr Scalar island_wait = 4;
+
+/// With `WorldDef::sleep_islands`, at the end of a step: true when the sleeper `s` joins the
+/// island of `b`, which touches it: `b` is awake and was not still in the step, and `s` did not
+/// fall asleep in it (`flagged`: an island that has just come to rest is not woken again by a
+/// neighbour that has not) nor by `island_wait` (it slept whatever its island did: joined again
+/// whenever a neighbour stays restless, two bodies of a pile that keep each other restless would
+/// hold it awake for ever).
+template <int D>
+bool joins_island(const WorldData<D>& w, const Body<D>& b, const Body<D>& s)
+{
+  return s.state == MotionState::asleep && b.state != MotionState::asleep && b.slow_time == 0 &&
+         s.slow_time < island_wait * w.def.sleep_time && !bit_set(w.flagged, std::uint32_t(&s - w.bodies));
+}
+
 /// Wakes a sleeper that an awake neighbour joins to its island (`WorldDef::sleep_islands`): as
 /// `wake`, but it keeps its still time, since nothing has moved it yet, and it is settling, not
 /// moving, so that with hull contacts it keeps its hull out of the ground (`hull_radius`) while
@@ -201,7 +229,7 @@ template <class FS = AllFeatures, int D>
 bool sleeps_from_anchor(const WorldData<D>& w, const Body<D>& b)
 {
   const Shape<D>& s = w.shapes[b.shape];
-  return FS::hull_contacts && w.def.body_contacts == BodyContacts::hulls && s.statistical && s.signature.contact.present();
+  return FS::hull_contacts && hull_contacts_on(w) && s.statistical && s.signature.contact.present();
 }
 
 }  // namespace detail

@@ -34,19 +34,23 @@ int main(int argc, char** argv)
     return 2;
   }
   const std::string dir = argv[1];
+  // Every value of the options that change the format's bytes: the defaults (automatic body
+  // contacts, islands), hulls asked for with each sleep rule, collision spheres.
   WorldDef3 d3;
-  WorldDef3 hulls;
-  hulls.body_contacts = BodyContacts::hulls;
-  hulls.broad_phase = BroadPhase::grid;
-  WorldDef3 islands = hulls;
-  islands.sleep_islands = true;
+  WorldDef3 islands;
+  islands.body_contacts = BodyContacts::hulls;
+  islands.broad_phase = BroadPhase::grid;
+  WorldDef3 hulls = islands;
+  hulls.sleep_islands = false;
+  WorldDef3 spheres;
+  spheres.body_contacts = BodyContacts::collision_spheres;
   WorldDef2 d2;
   WorldDef2 hulls2;
   hulls2.body_contacts = BodyContacts::hulls;
   const bool ok = write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d", d3, 30, 60) &&
                   write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d_hulls_grid", hulls, 30, 150) &&
                   write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d_islands", islands, 30, 150) &&
-                  write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d_small", d3, 5, 20) &&
+                  write_seed<3, fuzz::SnapWorld3>(dir, "seed_3d_small", spheres, 5, 20) &&
                   write_seed<2, fuzz::SnapWorld2>(dir, "seed_2d", d2, 30, 60) &&
                   write_seed<2, fuzz::SnapWorld2>(dir, "seed_2d_hulls", hulls2, 30, 150);
   if (!ok) std::fprintf(stderr, "snapshot_seeds: failed\n");

@@ -268,16 +268,16 @@ public:
       for (auto& s : box2d_settings(body2_)) result.settings.push_back(s);
     }
     result.settings.push_back(
-        "statsim: WorldDef defaults but body contacts " +
-        std::string(o_.hull_contacts ? "at the hulls (BodyContacts::hulls) where the table has body-body data"
-                                     : "at the collision spheres (the default)") +
+        "statsim: WorldDef defaults" +
+        std::string(o_.hull_contacts ? " (body contacts at the hulls where the table has body-body data)"
+                                     : " but body contacts at the collision spheres (BodyContacts::collision_spheres)") +
         (o_.workers > 1 ? "; " + std::to_string(o_.workers) +
                               " workers (WorldDef::workers, tools/common/task_pool.hpp: the CPU columns count the "
                               "calling thread only, compare the step columns)"
                         : std::string("; no workers")) +
         " (broad phase " + statsim_default_broad_phase() +
         "; statistical-sap / statistical-grid force sweep-and-prune / the grid" +
-        "; 4 support passes, shock propagation, sleep speed 0.05 m/s for 0.5 s), ground plane, float; world "
+        "; 4 support passes, shock propagation, sleep speed 0.05 m/s for 0.5 s, by islands), ground plane, float; world "
         "capacity: the smallest of 16, 128, 1024, 4096, 16384, 32768, 131072 holding N, 32 candidate pairs per body; "
         "seed = scene seed");
 

@@ -127,8 +127,8 @@ void register_bench_commands(CLI::App& app)
   b->add_option("--replot", cmd->replot, "Only redraw --chart from the CSV of an earlier run (--shape names the shape in the title)");
   b->add_flag("--quiet", cmd->quiet, "No progress on stderr");
   b->add_option("--body-contacts", o.hull_contacts,
-                "statsim: where bodies touch each other, hulls (WorldDef::body_contacts = hulls) or spheres (the "
-                "runtime's default)")
+                "statsim: where bodies touch each other, hulls (the library's default, WorldDef::body_contacts = "
+                "automatic: hulls where the table has body-body data) or spheres (the paper's collision spheres)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"hulls", true}, {"spheres", false}}))
       ->default_str("hulls");
   b->add_flag("--all-features", o.all_features,

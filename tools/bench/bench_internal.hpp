@@ -5,6 +5,7 @@
 #include "bench/bench.hpp"
 #include "bullet/drop_world.hpp"
 #include "scenes/scenes.hpp"
+#include "statsim/world_def.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -174,8 +175,8 @@ bool statsim_table3(const std::string& shape, SignatureView<3>& out);
 struct StatsimVariant {
   bool rest_conditions = true;     ///< WorldDef::rest_conditions
   bool independent_pairs = false;  ///< WorldDef::pair_response = independent (default: momentum)
-  /// WorldDef::body_contacts = hulls where the table has body-body data (tools/fidelity/README.md,
-  /// "With hull contacts"); false: the runtime's default, collision spheres.
+  /// WorldDef::body_contacts as the runtime's default (`automatic`: hulls where the table has
+  /// body-body data); false: collision spheres, the paper's rule.
   bool hull_contacts = true;
   /// Threads stepping the world (WorldDef::workers, through a tools::TaskPool); 1: none started.
   unsigned workers = 1;
@@ -192,6 +193,11 @@ const std::vector<std::pair<std::string, std::string>>& world_setting_names();
 /// Throws std::invalid_argument naming the known fields when `name` is not one of them, or when
 /// `value` is not one the field takes.
 void check_world_setting(const std::string& name, double value);
+/// The parameters of every statsim world of the bench and the fidelity tool: `WorldDef`'s defaults
+/// (the library's model) but for the seed and what `variant` and `broad_phase` (as for
+/// `make_statsim3`) change; `WorldDef::workers` is left to the caller.
+template <int D>
+WorldDef<D> statsim_world_def(std::uint64_t seed, const std::string& broad_phase, const StatsimVariant& variant);
 /// A statsim world with any signature (e.g. one loaded at run time); `sig`'s storage must outlive it.
 /// `walls`: static planes besides the ground (at most 7).
 std::unique_ptr<Sim> make_statsim3_table(const SignatureView<3>& sig, double mass, const scenes::DropScene3& scene,

@@ -90,6 +90,13 @@ void apply_settings(WorldDef<D>& def, const std::vector<std::pair<std::string, d
   }
 }
 
+/// Sets the broad phase: "" keeps the runtime's default; "grid" or "sap" forces one.
+void set_broad_phase(BroadPhase& broad_phase, const std::string& which)
+{
+  if (which.empty()) return;
+  broad_phase = which == "grid" ? BroadPhase::grid : BroadPhase::sweep_and_prune;
+}
+
 }  // namespace
 
 const std::vector<std::pair<std::string, std::string>>& world_setting_names()
@@ -110,6 +117,21 @@ void check_world_setting(const std::string& name, double value)
                                 s.meaning + ")");
 }
 
+template <int D>
+WorldDef<D> statsim_world_def(std::uint64_t seed, const std::string& broad_phase, const StatsimVariant& variant)
+{
+  WorldDef<D> def;
+  def.seed = seed;
+  def.rest_conditions = variant.rest_conditions;
+  if (!variant.hull_contacts) def.body_contacts = BodyContacts::collision_spheres;
+  if (variant.independent_pairs) def.pair_response = PairResponse::independent;
+  set_broad_phase(def.broad_phase, broad_phase);
+  apply_settings(def, variant.settings);
+  return def;
+}
+template WorldDef<2> statsim_world_def<2>(std::uint64_t, const std::string&, const StatsimVariant&);
+template WorldDef<3> statsim_world_def<3>(std::uint64_t, const std::string&, const StatsimVariant&);
+
 namespace {
 
 // Capacities: the world is sized to the scene (the smallest of these tiers that holds N), as a user
@@ -118,13 +140,6 @@ namespace {
 // spheres overlap in a pile (see tools/bench/README.md); an overflow is reported, never silent.
 constexpr std::uint32_t kCapacity = 131072;
 constexpr std::uint32_t kPairsPerBody = 32;
-
-/// Sets the broad phase: "" keeps the runtime's default; "grid" or "sap" forces one.
-void set_broad_phase(BroadPhase& broad_phase, const std::string& which)
-{
-  if (which.empty()) return;
-  broad_phase = which == "grid" ? BroadPhase::grid : BroadPhase::sweep_and_prune;
-}
 
 std::optional<SignatureView<3>> table3(const std::string& shape)
 {
@@ -189,16 +204,8 @@ public:
              const std::vector<bullet::Plane>& walls = {})
       : dt_(static_cast<Scalar>(dt)), pool_(variant.workers > 1 ? std::make_unique<TaskPool>(variant.workers) : nullptr)
   {
-    WorldDef<D> def;
-    def.seed = seed;
-    def.rest_conditions = variant.rest_conditions;
-    // The benchmark and the fidelity scenes measure the hull contacts of tables that have
-    // body-body data (tools/fidelity/README.md, "With hull contacts") unless told otherwise.
-    if (variant.hull_contacts) def.body_contacts = BodyContacts::hulls;
+    WorldDef<D> def = statsim_world_def<D>(seed, broad_phase, variant);
     if (pool_) def.workers = pool_->workers();
-    if (variant.independent_pairs) def.pair_response = PairResponse::independent;
-    set_broad_phase(def.broad_phase, broad_phase);
-    apply_settings(def, variant.settings);
     world_ = std::make_unique<WorldT>(def);
     if (world_->construction_status() != Status::ok)
       throw std::runtime_error(std::string("statsim world: ") + to_string(world_->construction_status()));

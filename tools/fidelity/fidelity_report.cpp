@@ -513,7 +513,8 @@ void register_fidelity_commands(CLI::App& app)
                   "comma-separated: full, full-gather (Bullet full with the gathering's settings at --dt: the "
                   "reference's engine at the methods' step), low, hull, spheres7, sphere, statistical, "
                   "statistical-norest, statistical-independent, statistical-spheres (collision spheres between bodies, the "
-                  "library's default; the others take hull contacts where the table has body-body data), "
+                  "paper's rule; the others run the library's default, hull contacts where the table has body-body "
+                  "data and sleep by islands), "
                   "statistical:NAME; a statistical method followed by +FIELD=VALUE sets WorldDef fields by name "
                   "(statistical+shock_propagation=0+support_iterations=8; fields: " + setting_list() + ") (default: "
                   "full,low,spheres7,sphere,statistical,statistical-norest,statistical-independent)");

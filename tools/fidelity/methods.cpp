@@ -311,13 +311,13 @@ Setup make_setup(const FidelityOptions& o)
       m.table_bytes = base_bytes;
       m.variant.rest_conditions = name != "statistical-norest";
       m.variant.independent_pairs = name == "statistical-independent";
-      // The library's default body-body model; the others take hull contacts where the table has
-      // body-body data, as statsim bench does.
+      // The library's default model (hull contacts where the table has body-body data, sleep by
+      // islands), as statsim bench runs it; "-spheres": the paper's collision spheres between bodies.
       m.variant.hull_contacts = name != "statistical-spheres";
       m.description = "statsim, " + base_name +
                       (name == "statistical-norest" ? ", resting conditions off"
                        : name == "statistical-independent" ? ", independent pair response"
-                       : name == "statistical-spheres"     ? ", collision spheres between bodies (the library's default)"
+                       : name == "statistical-spheres"     ? ", collision spheres between bodies (the paper's rule)"
                                                            : ", momentum pair response, resting conditions on");
       m.variant.settings = settings;
       for (const auto& [field, value] : settings) m.description += ", " + field + " = " + format_setting(value);

@@ -186,8 +186,7 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
   statsim::WorldDef2 def;
   def.restitution_threshold = sig.restitution_threshold;  // as Box2D's (1 m/s)
   def.pile_rest = o.pile_rest;
-  def.sleep_islands = o.sleep_islands;
-  def.body_contacts = statsim::BodyContacts::hulls;  // the tables' body-body data (README, "Hull contacts")
+  def.sleep_islands = o.sleep_islands;  // the default, hull contacts where the table has body-body data, kept
   auto world = std::make_unique<StatWorld>(def);
   if (world->construction_status() != statsim::Status::ok) {
     throw std::runtime_error("statsim world rejected its parameters");
@@ -518,7 +517,7 @@ std::string compare2d_table(const Compare2dResult& r)
        " drops (seeds " + std::to_string(o.seed) + ".." + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops) - 1) +
        ") of " + std::to_string(o.steps) + " steps of " + fmt("%.5g", o.dt) +
        " s; step times: least of " + std::to_string(o.repeat) + " identical runs, mean over the drops" +
-       (o.pile_rest ? "; statsim with pile_rest" : "") + (o.sleep_islands ? "; statsim with sleep_islands" : "") +
+       (o.pile_rest ? "; statsim with pile_rest" : "") + (o.sleep_islands ? "" : "; statsim without sleep_islands") +
        (o.box2d_substeps > 1 ? "; Box2D in " + std::to_string(o.box2d_substeps) + " substeps per step" : "") + "\n";
   t += "box2d_b: Box2D on seeds " + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops)) + ".." +
        std::to_string(o.seed + static_cast<std::uint64_t>(2 * o.drops) - 1) +
@@ -643,8 +642,9 @@ void register_compare2d_command(CLI::App& app)
       ->capture_default_str();
   c->add_flag("--pile-rest", cmd->options.pile_rest,
               "statsim: bodies settling on other bodies blend to the mean rest height (WorldDef::pile_rest)");
-  c->add_flag("--sleep-islands", cmd->options.sleep_islands,
-              "statsim: touching bodies fall asleep together, once all are still (WorldDef::sleep_islands)");
+  c->add_flag("!--no-sleep-islands", cmd->options.sleep_islands,
+              "statsim: each body falls asleep on its own (WorldDef::sleep_islands off; the default: touching "
+              "bodies fall asleep together, once all are still)");
   c->add_option("--history-every", cmd->options.history_every,
                 "Also show the highest centre and the bodies awake every this many seconds (mean over the drops)")
       ->check(CLI::NonNegativeNumber)

@@ -52,8 +52,8 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
     error = "unknown engine '" + o.engine + "' (bullet, statsim)";
     return false;
   }
-  if (o.hull_contacts && o.engine != "statsim") {
-    error = "--hull-contacts is statsim's (Bullet touches at its meshes)";
+  if (!o.hull_contacts && o.engine != "statsim") {
+    error = "--body-contacts is statsim's (Bullet touches at its meshes)";
     return false;
   }
   if (o.substeps < 1 || o.substeps > 256) {
@@ -94,7 +94,7 @@ bool reference_run(const ReferenceRunOptions& o, std::string& error)
   if (o.engine == "statsim") {
     WorldDef3 def;
     def.seed = o.seed;
-    if (o.hull_contacts) def.body_contacts = BodyContacts::hulls;
+    if (!o.hull_contacts) def.body_contacts = BodyContacts::collision_spheres;
     // A world of its own for every run (large: on the heap, not the stack), so that a run never
     // sees the bodies of the one before.
     const auto world = std::make_unique<RunWorld>(def);

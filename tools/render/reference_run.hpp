@@ -15,9 +15,9 @@ struct ReferenceRunOptions {
   double seconds = 6.0;             ///< simulated time
   int every = 6;                    ///< write every k-th step of 1/60 s
   std::uint64_t seed = 1;           ///< scene layout (and statsim's world seed)
-  /// statsim: bodies touch at their hulls (`BodyContacts::hulls`, as `statsim bench` and
-  /// `statsim fidelity` run them) instead of the paper's collision spheres, the library's default
-  bool hull_contacts = false;
+  /// statsim: the library's default, bodies touch at their hulls (`BodyContacts::automatic`, as
+  /// `statsim bench` and `statsim fidelity` run them); false: at the paper's collision spheres
+  bool hull_contacts = true;
   /// Bullet: internal steps per step of 1/60 s (4: 1/240 s; the 50-bunny piles' reference is
   /// converged at 16, 1/960 s: tools/fidelity/README.md, "Is the reference converged?").
   int substeps = 4;

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -273,9 +274,11 @@ void register_render_commands(CLI::App& app)
   rr->add_option("--substeps", o->substeps, "Bullet: internal steps per step of 1/60 s (16: 1/960 s, the converged step)")
       ->capture_default_str();
   rr->add_option("--meshes", o->meshes_dir, "directory of the meshes")->capture_default_str();
-  rr->add_flag("--hull-contacts", o->hull_contacts,
-               "statsim: bodies touch at their hulls (BodyContacts::hulls, as statsim bench and fidelity run them), "
-               "not at the paper's collision spheres");
+  rr->add_option("--body-contacts", o->hull_contacts,
+                 "statsim: where bodies touch each other, hulls (the library's default, as statsim bench and fidelity "
+                 "run them) or spheres (the paper's collision spheres)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"hulls", true}, {"spheres", false}}))
+      ->default_str("hulls");
   rr->callback([o]() {
     std::string error;
     if (!render::reference_run(*o, error)) {

@@ -77,7 +77,7 @@ public:
   }
   BodyContacts contacts() const
   {
-    return opt_.hull_contacts ? BodyContacts::hulls : BodyContacts::collision_spheres;
+    return opt_.hull_contacts ? BodyContacts::automatic : BodyContacts::collision_spheres;
   }
 
 private:

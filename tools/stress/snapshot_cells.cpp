@@ -82,7 +82,7 @@ void snapshot_cells(bool want3, bool want2, bool hull_contacts, const AddCell& a
     const scenes::DropScene3 scene = scenes::drop_scene3(o);
     const Scalar wall = Scalar(scene.region.radius + o.bounding_radius);
     WorldDef3 def;
-    def.body_contacts = hull_contacts ? BodyContacts::hulls : BodyContacts::collision_spheres;
+    def.body_contacts = hull_contacts ? BodyContacts::automatic : BodyContacts::collision_spheres;
     auto a = std::make_unique<W>(def);
     auto b = std::make_unique<W>(def);
     for (W* w : {a.get(), b.get()}) {
@@ -105,7 +105,7 @@ void snapshot_cells(bool want3, bool want2, bool hull_contacts, const AddCell& a
     const scenes::DropScene2 scene = scenes::drop_scene2(o);
     const Scalar wall = Scalar(scene.region.half_width + o.bounding_radius);
     WorldDef2 def;
-    def.body_contacts = hull_contacts ? BodyContacts::hulls : BodyContacts::collision_spheres;
+    def.body_contacts = hull_contacts ? BodyContacts::automatic : BodyContacts::collision_spheres;
     auto a = std::make_unique<W>(def);
     auto b = std::make_unique<W>(def);
     for (W* w : {a.get(), b.get()}) {

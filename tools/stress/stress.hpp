@@ -19,9 +19,9 @@ struct StressOptions {
   bool quick = false;                ///< smaller scenes and budgets (about a minute)
   double budget_s = 60.0;            ///< wall-clock budget of one reference-engine cell
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes
-  /// statsim's worlds with `BodyContacts::hulls` (the tables' body-body data) instead of the
-  /// default collision spheres.
-  bool hull_contacts = false;
+  /// statsim's worlds with the library's default body contacts (`BodyContacts::automatic`: hulls
+  /// where the tables have body-body data); false: the paper's collision spheres.
+  bool hull_contacts = true;
   bool progress = true;
 };
 

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -54,8 +55,11 @@ void register_stress_commands(CLI::App& app)
   cmd->add_option("--budget", opts->budget_s, "Wall-clock seconds one Bullet cell of the pile or energy scene may take")
       ->capture_default_str();
   cmd->add_option("--meshes", opts->meshes_dir, "Directory of bunny.obj, bunny_low.obj, bunny_spheres7.txt");
-  cmd->add_flag("--hull-contacts", opts->hull_contacts,
-                "statsim's bodies touch at their hulls (WorldDef::body_contacts = hulls), not their collision spheres");
+  cmd->add_option("--body-contacts", opts->hull_contacts,
+                  "statsim: where bodies touch each other, hulls (the library's default, where the tables have "
+                  "body-body data) or spheres (the paper's collision spheres)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"hulls", true}, {"spheres", false}}))
+      ->default_str("hulls");
   cmd->callback([opts, json]() {
     const std::vector<StressCell> cells = run_stress(*opts);
     std::cout << stress_markdown(cells);

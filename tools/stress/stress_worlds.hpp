@@ -59,7 +59,7 @@ struct Setup3 {
   /// statistical shape (the particle model).
   bool particle = false;
   /// statsim: where bodies touch (`StressOptions::hull_contacts`).
-  BodyContacts body_contacts = BodyContacts::collision_spheres;
+  BodyContacts body_contacts = BodyContacts::automatic;
   /// statsim: the table; null: the bunny's. Bullet takes the `Body3` it is given.
   const SignatureView<3>* signature = nullptr;
   /// Body i has the shape's mass (and inertia) times `mass_scale[i]`; empty: all 1.
@@ -157,7 +157,7 @@ public:
     // collision spheres the overlap is that of the spheres over the sum of their radii; with
     // hull contacts that of the hulls over the separation at which the runtime's own rule lets
     // them touch (the closest hull candidate times its packing ratio), as tests/test_hull_contacts does.
-    const bool hulls = world_->def().body_contacts == BodyContacts::hulls;
+    const bool hulls = world_->def().body_contacts != BodyContacts::collision_spheres;  // Features::all
     const std::uint32_t n = world_->body_count();
     std::vector<std::pair<double, std::uint32_t>> xs(n);
     double rmax = 0;
