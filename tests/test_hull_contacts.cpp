@@ -4,6 +4,7 @@
 #include "statsim/snapshot.hpp"
 #include "statsim/statsim.hpp"
 #include "tables/box.hpp"
+#include "tables/bunny.hpp"
 #include "tables/lshape.hpp"
 #include "tables/lshape2d.hpp"
 #include "tables/square2d.hpp"
@@ -395,4 +396,37 @@ TEST_CASE("hull contacts: the face contacts kept between a step's passes give th
   CHECK(kept > 1000);
   compare_kept_contacts<2, World2<64>>(tables::square2d.view(), tables::lshape2d.view(), Scalar(0.5), 400, 5, kept);
   CHECK(kept > 1000);
+}
+
+TEST_CASE("hull contacts: the broad phase lists no pair beyond the reach at which the impact pass's search could find a contact")
+{
+  // Two bunnies at rest, without gravity, at distances around the largest packing ratio P times the
+  // sum of their bounding radii R: below it they are a candidate pair (their search decides), above
+  // it never. With a plain sphere shape in the world the reach is the bounding radii's again.
+  const auto pairs_at = [](Scalar fraction, bool with_sphere) {
+    WorldDef3 def;
+    def.gravity = Vector3::Zero();
+    auto w = std::make_unique<World3<4>>(def);
+    const auto bunny = w->add_shape(tables::bunny.view());
+    REQUIRE(bunny.ok());
+    if (with_sphere) {
+      ShapeDef ball;
+      ball.radius = Scalar(0.05);
+      REQUIRE(w->add_shape(ball).ok());
+    }
+    const Shape<3>& s = w->shape(bunny.id);
+    REQUIRE(s.largest_packing < Scalar(0.99));
+    const Scalar d = fraction * s.largest_packing * 2 * s.bounding_radius;
+    for (int i = 0; i < 2; ++i) {
+      BodyDef3 b;
+      b.shape = bunny.id;
+      b.position = Vector3(Scalar(i) * d, 0, 1);
+      REQUIRE(w->add_body(b).ok());
+    }
+    REQUIRE(w->step(Scalar(1) / 60).ok());
+    return w->pair_count();
+  };
+  CHECK(pairs_at(Scalar(0.99), false) == 1);
+  CHECK(pairs_at(Scalar(1.01), false) == 0);
+  CHECK(pairs_at(Scalar(1.01), true) == 1);
 }

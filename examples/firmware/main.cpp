@@ -119,7 +119,7 @@ constexpr statsim::Scalar dt = statsim::Scalar(1) / 60;
 // Candidate pairs per body (with the default hull contacts the broad phase pairs the bounding
 // spheres, `detail::pair_radius`), each shape's measured peak with a margin of a third or more
 // (examples/firmware/README.md). A step reports an overflow, and this program then fails.
-constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 0 ? 25 * bodies / 4 : (FIRMWARE_SHAPE == 1 ? 7 : 11) * bodies);
+constexpr std::uint32_t pairs3 = (FIRMWARE_SHAPE == 0 ? 25 * bodies / 4 : (FIRMWARE_SHAPE == 1 ? 6 : 8) * bodies);
 constexpr std::uint32_t pairs2 = 7 * bodies / 2;
 // Scenes that grow with the body count: columns of bodies four high in 3D (k x k columns, k a
 // multiple of 4) and eight high in 2D.

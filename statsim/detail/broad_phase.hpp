@@ -30,10 +30,11 @@ inline Pair make_pair(std::uint32_t a, std::uint32_t b)
 /// them; counts it either way it fits. The bounding spheres are tested first: most pairs of a
 /// sweep are apart, and that test needs no radius of the pair when every shape has the same
 /// bounding radius (`common_reach`: twice `WorldData::common_bound`, or 0). `bounding`: the pair
-/// radii are the bounding radii (hull contacts, every shape with a hull).
+/// radii are the bounding radii (hull contacts, every shape with a hull), times `reach_scale`
+/// (`pair_reach`).
 template <class FS, int D>
 void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_reach, bool bounding,
-               std::uint32_t& found)
+               Scalar reach_scale, std::uint32_t& found)
 {
   const Body<D>& ba = w.bodies[a];
   const Body<D>& bb = w.bodies[b];
@@ -41,7 +42,7 @@ void candidate(WorldData<D>& w, std::uint32_t a, std::uint32_t b, Scalar common_
                                         : w.shapes[ba.shape].bounding_radius + w.shapes[bb.shape].bounding_radius;
   const Scalar d2 = (bb.position - ba.position).squaredNorm();
   if (d2 > bound * bound) return;
-  const Scalar reach = bounding ? bound : pair_radius<FS>(w, ba) + pair_radius<FS>(w, bb);
+  const Scalar reach = bounding ? bound * reach_scale : pair_radius<FS>(w, ba) + pair_radius<FS>(w, bb);
   if (d2 > reach * reach) return;
   if (found < w.max_pairs) w.pairs[found] = a < b ? make_pair(a, b) : make_pair(b, a);
   ++found;
@@ -53,6 +54,7 @@ struct GridSearch {
   WorldData<D>* w;
   Scalar widest;  ///< the largest `pair_radius` of the bodies, m (half a cell)
   bool regular;   ///< no body in a clamped cell (else every neighbouring cell is visited)
+  Scalar reach;   ///< `pair_reach`: the records' and the searching body's radii are scaled by it
 };
 
 /// The cell of body i, as `SpatialHash::build` sorted it.
@@ -92,7 +94,7 @@ void search_grid(const GridSearch<D>& s, std::uint32_t first_word, std::uint32_t
   const auto search = [&](std::uint32_t i) {
     const Body<D>& bi = w.bodies[i];
     const Vec p = bi.position;
-    const Scalar radius = pair_radius(w, bi);
+    const Scalar radius = pair_radius(w, bi, s.reach);
     std::int32_t c[3];
     grid_cell(grid, p, c);
     // Where the body is in its cell, in cells: a neighbouring cell holds a body it can touch only
@@ -267,7 +269,9 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
 {
   SpatialHash<D>& grid = w.grid;
   // The widest reach of this step. Collision spheres change size with spin, so it is measured
-  // afresh; it is never above the widest bounding diameter.
+  // afresh; it is never above the widest bounding diameter. It is taken without `pair_reach`:
+  // the cell's size sets the order in which pairs are found, and so the order of the impacts.
+  const Scalar reach = pair_reach<FS>(w);
   Scalar widest = 0;
   for (std::uint32_t i = 0; i < w.body_count; ++i) {
     const Scalar r = pair_radius<FS>(w, w.bodies[i]);
@@ -283,14 +287,14 @@ std::uint32_t find_pairs_grid(WorldData<D>& w, StepResult& result)
   };
   // The awake bit set tells the sleepers without reading the bodies; each record is made once.
   const auto asleep = [&w](std::uint32_t i) { return !bit_set(w.awake, i); };
-  const auto item = [&w, &asleep](std::uint32_t i) {
+  const auto item = [&w, &asleep, reach](std::uint32_t i) {
     const Body<D>& b = w.bodies[i];
-    return GridItem<D>{b.position, pair_radius<FS>(w, b), asleep(i) ? i + asleep_key : i};
+    return GridItem<D>{b.position, pair_radius<FS>(w, b, reach), asleep(i) ? i + asleep_key : i};
   };
   grid.build(w.body_count, cell, item, asleep);
   made_records(w, true);
   result.broad_phase_bodies += w.body_count;
-  const GridSearch<D> s{&w, widest, regular};
+  const GridSearch<D> s{&w, widest, regular, reach};
   std::uint32_t found = 0, examined = 0;
 #if STATSIM_WORKERS
   // (The parts' records are on the stack of `search_grid_parts`, called only with workers.)
@@ -335,16 +339,17 @@ std::uint32_t find_pairs_sweep(WorldData<D>& w, StepResult& result)
   // With hull contacts every pair radius is the bounding radius where every shape has a hull.
   bool bounding = FS::hull_contacts && hull_contacts_on(w);
   for (std::uint32_t k = 0; k < w.shape_count; ++k) bounding = bounding && has_hull(w.shapes[k]);
+  const Scalar reach_scale = pair_reach<FS>(w);
   const Scalar common_reach = common + common;
   const Scalar common_reach2 = common_reach * common_reach;
   const Body<D>* bodies = w.bodies;
   sweep_active(w.entries, w.body_count, widest,
-               [&w, &found, bodies, common_reach, common_reach2, bounding](std::uint32_t a, std::uint32_t b) {
+               [&w, &found, bodies, common_reach, common_reach2, bounding, reach_scale](std::uint32_t a, std::uint32_t b) {
     // `candidate`'s first test, here where the sweep can keep body a's centre at hand: most pairs
     // whose intervals overlap are apart, and with one bounding radius for every shape the test
     // reads nothing else.
     if (common_reach > 0 && (bodies[b].position - bodies[a].position).squaredNorm() > common_reach2) return;
-    candidate<FS>(w, a, b, common_reach, bounding, found);
+    candidate<FS>(w, a, b, common_reach, bounding, reach_scale, found);
   });
   return found;
 }
