@@ -182,7 +182,7 @@ void main() {
   vec2 c = floor(vWorld * 2.0);
   float check = mod(c.x + c.y, 2.0);
   float fade = clamp(1.0 - length(vWorld) / extent, 0.0, 1.0);
-  colour = vec4(mix(vec3(0.80), vec3(0.86 + 0.05 * check), fade), 1.0);
+  colour = vec4(mix(vec3(0.93, 0.94, 0.96), vec3(0.80 + 0.07 * check), fade), 1.0);
 }`;
 // Impact flashes: a ring per impact that grows and fades over its life.
 const flashShader = `#version 300 es
@@ -256,7 +256,7 @@ function viewProjection(cam, aspect) {
 class Renderer {
   constructor(canvas) {
     this.canvas = canvas;
-    const gl = canvas.getContext('webgl2', { antialias: true });
+    const gl = canvas.getContext('webgl2', { antialias: !params.has('noaa') });
     if (!gl) throw new Error('WebGL2 is not available');
     this.gl = gl;
     this.meshProgram = program(gl, meshShader, meshFragment);
@@ -388,7 +388,7 @@ function defaultCamera(shape, count) {
     const height = Math.max(4, (1.2 * count) / spread) * 0.5;
     return { yaw: -Math.PI / 2, pitch: 0.08, distance: 1.9 * Math.max(spread, height), target: [0, 0, 0.45 * height], fov: 0.8 };
   }
-  return { yaw: -0.9, pitch: 0.5, distance: 3.2 * spread, target: [0, 0, 0.18 * spread], fov: 0.8 };
+  return { yaw: -0.9, pitch: 0.62, distance: 2.7 * spread, target: [0, 0, 0], fov: 0.8 };
 }
 
 // ---- ?drawbench: the drawing's cost per frame, after a pour ------------------------------------
@@ -413,11 +413,13 @@ async function drawbench() {
   const stepMs = (performance.now() - t0) / Math.max(1, steps);
   const cam = defaultCamera(shape, n);
   const spread = sceneSpread(shape, n);
+  const pixel = new Uint8Array(4);
   const draw = () => {
     const pointer = demo.demo_transforms();
     const count = demo.demo_drawn();
     renderer.draw(cam, new Float32Array(demo.memory.buffer, pointer, 16 * count), count, [], 4 * spread);
-    renderer.gl.finish();
+    // gl.finish() returns before the GPU process has drawn; reading a pixel waits for it.
+    renderer.gl.readPixels(0, 0, 1, 1, renderer.gl.RGBA, renderer.gl.UNSIGNED_BYTE, pixel);
   };
   draw();
   const t1 = performance.now();
@@ -450,7 +452,7 @@ async function live() {
     return '0x' + hex(demo.demo_hash_high()) + hex(demo.demo_hash_low());
   };
   function readout() {
-    $('readout').textContent = `${state.msPerStep.toFixed(2)} ms per step · ${state.drawMs.toFixed(1)} ms per frame drawing · ` +
+    $('readout').textContent = `${state.msPerStep.toFixed(2)} ms per step · ${state.drawMs.toFixed(1)} ms per frame in draw calls · ` +
                                `${demo.demo_asleep()} asleep · ${(state.steps / 60).toFixed(1)} s`;
     $('bodies').textContent = String(demo.demo_live_count());
     $('hash').textContent = hashText();

@@ -15,7 +15,8 @@
 //                           +100 and -100 change the body count; a scene and a model switch reset
 //                           the world. Prints what it saw; fails when any check fails.
 //   --screenshot FILE.png [--query QUERY] [--steps K]
-//                           the live page (1200 x 700) after K steps (default 240)
+//                           the live page (1200 x 700) after about K steps (default 240; paused,
+//                           then stepped by its "+1 s" button)
 // Options: --chromium PATH (default /usr/bin/chromium), --timeout SECONDS (default 600).
 // playwright-core drives Chromium over the DevTools protocol; it is installed into the build
 // tree by the main build (examples/CMakeLists.txt), with no browser download.
@@ -159,7 +160,12 @@ try {
     const query = option('--query', '');
     const steps = Number(option('--steps', 240));
     await page.goto(`${base}${query ? '?' + query : ''}`);
-    await page.waitForFunction((k) => window.statsim && window.statsim.steps >= k, steps, { timeout });
+    // Paused at once, then stepped by the page's own "+1 s" button: the software renderer draws
+    // a frame in about a second, too slow to watch a pile form frame by frame.
+    await page.waitForFunction(() => window.statsim && window.statsim.steps >= 1, null, { timeout });
+    await page.click('#pause');
+    for (let k = 1; k < steps; k += 60) await page.click('#advance');
+    await page.evaluate(() => new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve))));
     await page.screenshot({ path: option('--screenshot') });
     const readout = await page.textContent('#readout');
     console.log(`screenshot ${option('--screenshot')} after ${steps} steps: ${readout}`);
