@@ -236,7 +236,7 @@ function cameraFrame(cam) {
   const back = [cp * cy, cp * sy, sp];
   const eye = back.map((b, i) => cam.target[i] + cam.distance * b);
   const forward = back.map((b) => -b);
-  const right = [sy, -cy, 0];
+  const right = [-sy, cy, 0];
   const up = [right[1] * forward[2] - right[2] * forward[1], right[2] * forward[0] - right[0] * forward[2],
               right[0] * forward[1] - right[1] * forward[0]];
   return { eye, forward, right, up };
@@ -388,7 +388,7 @@ function defaultCamera(shape, count) {
     const height = Math.max(4, (1.2 * count) / spread) * 0.5;
     return { yaw: -Math.PI / 2, pitch: 0.08, distance: 1.9 * Math.max(spread, height), target: [0, 0, 0.45 * height], fov: 0.8 };
   }
-  return { yaw: -0.9, pitch: 0.62, distance: 2.7 * spread, target: [0, 0, 0], fov: 0.8 };
+  return { yaw: -0.9, pitch: 0.62, distance: 2.0 * spread, target: [0, 0, 0], fov: 0.8 };
 }
 
 // ---- ?drawbench: the drawing's cost per frame, after a pour ------------------------------------
