@@ -439,7 +439,7 @@ async function live() {
   const controls = { count: $('count'), shape: $('shape'), scene: $('scene'), model: $('model'), rest: $('rest'), seed: $('seed') };
   if (params.has('n')) controls.count.value = params.get('n');
   if (params.has('shape')) controls.shape.value = String(Math.max(0, shapeNames.indexOf(params.get('shape'))));
-  if (params.has('scene')) controls.scene.value = String(Math.max(0, ['pour', 'bin', 'column'].indexOf(params.get('scene'))));
+  if (params.has('scene')) controls.scene.value = String(Math.max(0, ['pour', 'bin', 'column', 'heap'].indexOf(params.get('scene'))));
   if (params.has('model')) controls.model.value = params.get('model') === 'spheres' ? '1' : '0';
   if (params.has('rest')) controls.rest.checked = params.get('rest') !== '0';
   if (params.has('seed')) controls.seed.value = params.get('seed');
@@ -453,7 +453,9 @@ async function live() {
   };
   function readout() {
     $('readout').textContent = `${state.msPerStep.toFixed(2)} ms per step · ${state.drawMs.toFixed(1)} ms per frame in draw calls · ` +
-                               `${demo.demo_asleep()} asleep · ${(state.steps / 60).toFixed(1)} s`;
+                               `${demo.demo_asleep() - demo.demo_waiting()} asleep · ` +
+                               (demo.demo_waiting() ? `${demo.demo_waiting()} waiting for the nozzle · ` : '') +
+                               `${(state.steps / 60).toFixed(1)} s`;
     $('bodies').textContent = String(demo.demo_live_count());
     $('hash').textContent = hashText();
   }

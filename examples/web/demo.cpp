@@ -46,12 +46,16 @@ World3 world3;
 World2 world2;
 
 /// Scenes, in the order of the page's menu (set by `demo_configure` for the next reset).
-enum Scene : int { pour = 0, bin = 1, column = 2 };
+enum Scene : int { pour = 0, bin = 1, column = 2, heap = 3 };
 /// Body-body models: the library's default (hulls where the tables have the data), or the
 /// paper's collision spheres.
 enum Model : int { model_default = 0, model_spheres = 1 };
 int scene = pour;
 int model = model_default;
+/// Heap scene: bodies waiting asleep above the nozzle, released one a step in slot order.
+std::uint32_t heap_bodies = 0, heap_released = 0;
+float heap_cell = 0, heap_nozzle = 0;
+statsim::Pcg32 heap_rng(1, 4);
 std::uint32_t current_seed = 1;
 bool current_rest = true;
 /// Draws of spawned bodies and of removals: a stream of their own, so that the pour's bits do
@@ -63,6 +67,7 @@ unsigned char snapshot3[statsim::snapshot_capacity<3>(capacity, 5, 1)];
 unsigned char snapshot2[statsim::snapshot_capacity<2>(capacity, 3, 1)];
 std::size_t snapshot_bytes = 0;
 int snapshot_shape = -1;
+std::uint32_t snapshot_released = 0;  // the heap's release count when saved
 
 /// Shapes, in the order of the page's menu.
 enum Shape : int { bunny = 0, box = 1, lshape = 2, square = 3 };
@@ -145,7 +150,10 @@ std::uint32_t bin_cells(std::uint32_t n)
 /// 3D scenes. pour: a column of radius 0.1 sqrt(n) m over the ground plane (the heap of paper
 /// Figure 6), one body per `rise` of height from 0.3 m up. bin: four walls round a square lattice
 /// filled layer by layer. column: columns of ten bodies, every body in the orientation of the
-/// table's body frame, one bounding diameter apart, the columns in a square grid.
+/// table's body frame, one bounding diameter apart, the columns in a square grid. heap (as
+/// tools/scenes' heap): the bodies wait asleep in a lattice far above a nozzle and `demo_step`
+/// releases one a step from the corners of a square round the axis in turn, at
+/// (1.5 + 0.75 cbrt(n)) cells above the ground, falling at 2 m/s.
 statsim::Status pour3(int shape, std::uint32_t n, bool rest, std::uint32_t seed)
 {
   world3.~World3();
@@ -172,9 +180,21 @@ statsim::Status pour3(int shape, std::uint32_t n, bool rest, std::uint32_t seed)
   const float rise = 2.0f / float(n) + 0.0004f;
   std::uint32_t side = 1;
   while (side * side * 10 < n) ++side;
+  std::uint32_t root = 1;
+  while (root * root * root < n) ++root;
+  heap_bodies = scene == heap ? n : 0;
+  heap_released = 0;
+  heap_cell = cell;
+  heap_nozzle = (1.5f + 0.75f * float(root)) * cell;
+  heap_rng = statsim::Pcg32(seed, 4);
   for (std::uint32_t i = 0; i < n; ++i) {
     statsim::Status s = statsim::Status::ok;
-    if (scene == bin) {
+    if (scene == heap) {
+      const std::uint32_t row = 4 * root, layer = i / (row * row), k = i % (row * row);
+      const float x = cell * (float(k % row) - 0.5f * float(row)), y = cell * (float(k / row) - 0.5f * float(row));
+      const auto a = world3.add_body(body3(added.id, shape, rng, x, y, heap_nozzle + cell * (10 + float(layer))));
+      s = a.ok() ? world3.sleep(a.id) : a.status;
+    } else if (scene == bin) {
       const std::uint32_t layer = i / (cells * cells), k = i % (cells * cells);
       const float jx = rng.uniform(-0.05f, 0.05f) * cell, jy = rng.uniform(-0.05f, 0.05f) * cell;
       const float x = -half + cell * (0.5f + float(k % cells)) + jx;
@@ -267,7 +287,7 @@ extern "C" {
 /// 1 collision spheres) of the next `demo_reset`. Returns 0, or `invalid_parameter`.
 int demo_configure(int new_scene, int new_model)
 {
-  if (new_scene < pour || new_scene > column || new_model < model_default || new_model > model_spheres)
+  if (new_scene < pour || new_scene > heap || new_model < model_default || new_model > model_spheres)
     return int(statsim::Status::invalid_parameter);
   scene = new_scene;
   model = new_model;
@@ -286,6 +306,7 @@ int demo_reset(int shape, std::uint32_t n, int rest_conditions, std::uint32_t se
   extra_rng = statsim::Pcg32(seed, 3);
   snapshot_bytes = 0;
   drawn = 0;
+  heap_bodies = heap_released = 0;
   const statsim::Status s = shape == square ? pour2(n, rest_conditions != 0, seed) : pour3(shape, n, rest_conditions != 0, seed);
   return int(s);
 }
@@ -296,6 +317,22 @@ int demo_step(int count)
 {
   constexpr float dt = 1.0f / 60;
   for (int i = 0; i < count; ++i) {
+    if (current != square && heap_released < heap_bodies) {
+      // The heap's next body leaves its place in the waiting lattice for the nozzle.
+      const statsim::BodyId id = core3().id_of(heap_released);
+      const float spot = 0.5f * heap_cell, jitter = 0.25f * heap_cell;
+      const float sx = (heap_released & 1) ? spot : -spot, sy = (heap_released & 2) ? spot : -spot;
+      const float jx = heap_rng.uniform(-jitter, jitter), jy = heap_rng.uniform(-jitter, jitter);
+      ++heap_released;
+      if (const statsim::Body3* b = core3().find_body(id)) {
+        const statsim::Quaternion q = b->orientation;
+        if (core3().set_transform(id, statsim::Vector3(sx + jx, sy + jy, heap_nozzle), q) == statsim::Status::ok) {
+          const float vx = heap_rng.uniform(-0.2f, 0.2f), vy = heap_rng.uniform(-0.2f, 0.2f);
+          const float wx = heap_rng.uniform(-2, 2), wy = heap_rng.uniform(-2, 2);
+          (void)core3().set_velocity(id, statsim::Vector3(vx, vy, -2), statsim::Vector3(wx, wy, 0));
+        }
+      }
+    }
     const statsim::StepResult r = current == square ? core2().step(dt) : core3().step(dt);
     if (r.status != statsim::Status::ok) return int(r.status);
     if (r.pairs_dropped) return -1;
@@ -305,6 +342,8 @@ int demo_step(int count)
 
 /// Body slots in use (removed bodies' included; the number the hash lines print).
 std::uint32_t demo_body_count() { return current == square ? core2().body_count() : core3().body_count(); }
+/// Heap scene: bodies still waiting (asleep) to be released.
+std::uint32_t demo_waiting() { return heap_bodies - heap_released; }
 /// Bodies in the world.
 std::uint32_t demo_live_count() { return current == square ? core2().live_body_count() : core3().live_body_count(); }
 
@@ -349,6 +388,7 @@ const float* demo_transforms()
       for (int k = 0; k < 12; ++k) t[k] = rows[k];
       t[12] = draw_class(*b);
     } else {
+      if (i >= heap_released && i < heap_bodies) continue;  // still waiting above the heap
       const statsim::BodyId id = core3().id_of(i);
       const statsim::Body3* b = core3().find_body(id);
       if (!b) continue;
@@ -439,6 +479,7 @@ int demo_save()
                                               : statsim::save(core3(), snapshot3, sizeof snapshot3, &written);
   snapshot_bytes = s == statsim::Status::ok ? written : 0;
   snapshot_shape = s == statsim::Status::ok ? current : -1;
+  snapshot_released = heap_released;
   return int(s);
 }
 /// Bytes of the saved snapshot (0: none).
@@ -451,6 +492,7 @@ int demo_restore()
   if (snapshot_bytes == 0 || snapshot_shape != current) return int(statsim::Status::invalid_parameter);
   const statsim::Status s = current == square ? statsim::load(core2(), snapshot2, snapshot_bytes)
                                               : statsim::load(core3(), snapshot3, snapshot_bytes);
+  if (s == statsim::Status::ok) heap_released = snapshot_released;
   return int(s);
 }
 
