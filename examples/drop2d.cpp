@@ -97,6 +97,28 @@ struct Image {
           std::memcpy(&rgb[std::size_t((y * w + x) * 3)], colour, 3);
     }
   }
+  void rect(float x0, float y0, float x1, float y1, const unsigned char colour[3])
+  {
+    fill({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, colour);
+  }
+  /// Writes `text` from (x, y) (its top left), `px` pixels per dot of a 5 x 7 font that has
+  /// only the legend's letters.
+  void text(float x, float y, const char* text, float px, const unsigned char colour[3])
+  {
+    static const struct {
+      char c;
+      const char* rows;  // 7 rows of 5 dots
+    } font[] = {{'s', "...........#####.....###.....#####."}, {'q', "...........#####...#.####....#....#"},
+                {'u', "..........#...##...##...##..##.##.#"}, {'a', "...........###.....#.#####...#.####"},
+                {'r', "..........#.##.##..##....#....#...."}, {'e', "...........###.#...#######.....###."},
+                {'L', "#....#....#....#....#....#....#####"}, {'-', "...............#####..............."},
+                {'h', "#....#....#.##.##..##...##...##...#"}, {'p', "..........####.#...#####.#....#...."}};
+    for (; *text; ++text, x += 6 * px)
+      for (const auto& g : font)
+        if (g.c == *text)
+          for (int k = 0; k < 35; ++k)
+            if (g.rows[k] == '#') rect(x + float(k % 5) * px, y + float(k / 5) * px, x + float(k % 5 + 1) * px, y + float(k / 5 + 1) * px, colour);
+  }
 };
 }  // namespace
 
@@ -226,6 +248,18 @@ int main(int argc, char** argv)
         poly.emplace_back((q.x() + half_width) * scale, float(h) - (q.y() + 0.5f) * scale);
       }
       img.fill(poly, colours[s]);
+    }
+    // The legend, top left: each shape in its colour, named.
+    const unsigned char frame[3] = {200, 200, 200}, white[3] = {255, 255, 255}, ink[3] = {40, 40, 40};
+    img.rect(6, 6, 166, 82, frame);
+    img.rect(7, 7, 165, 81, white);
+    const char* names[2] = {"square", "L-shape"};
+    for (int s = 0; s < 2; ++s) {
+      std::vector<Vector2> icon;
+      const float cx = 30, cy = 26 + 34 * float(s);
+      for (const Vector2& p : outlines[s].points) icon.emplace_back(cx + 20 * p.x(), cy - 20 * p.y());
+      img.fill(icon, colours[s]);
+      img.text(60, cy - 7, names[s], 2, ink);
     }
     if (!stbi_write_png(png, w, h, 3, img.rgb.data(), w * 3)) {
       std::fprintf(stderr, "drop2d: cannot write %s\n", png);
