@@ -24,6 +24,7 @@
 #pragma GCC diagnostic ignored "-Wshadow"
 #endif
 #define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_easy_font.h>
 #include <stb/stb_image_write.h>
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
@@ -101,23 +102,18 @@ struct Image {
   {
     fill({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, colour);
   }
-  /// Writes `text` from (x, y) (its top left), `px` pixels per dot of a 5 x 7 font that has
-  /// only the legend's letters.
+  /// Writes `text` from (x, y) (its top left), `px` pixels per dot of stb_easy_font's glyphs.
   void text(float x, float y, const char* text, float px, const unsigned char colour[3])
   {
-    static const struct {
-      char c;
-      const char* rows;  // 7 rows of 5 dots
-    } font[] = {{'s', "...........#####.....###.....#####."}, {'q', "...........#####...#.####....#....#"},
-                {'u', "..........#...##...##...##..##.##.#"}, {'a', "...........###.....#.#####...#.####"},
-                {'r', "..........#.##.##..##....#....#...."}, {'e', "...........###.#...#######.....###."},
-                {'L', "#....#....#....#....#....#....#####"}, {'-', "...............#####..............."},
-                {'h', "#....#....#.##.##..##...##...##...#"}, {'p', "..........####.#...#####.#....#...."}};
-    for (; *text; ++text, x += 6 * px)
-      for (const auto& g : font)
-        if (g.c == *text)
-          for (int k = 0; k < 35; ++k)
-            if (g.rows[k] == '#') rect(x + float(k % 5) * px, y + float(k / 5) * px, x + float(k % 5 + 1) * px, y + float(k / 5 + 1) * px, colour);
+    // stb_easy_font writes each dot run as a quad of four vertices of 16 bytes: x, y, z, colour.
+    static char quads[16 * 4 * 400];
+    const int count = stb_easy_font_print(0, 0, const_cast<char*>(text), nullptr, quads, int(sizeof quads));
+    for (int q = 0; q < count; ++q) {
+      float corner[2][2];
+      std::memcpy(corner[0], quads + q * 64, sizeof corner[0]);
+      std::memcpy(corner[1], quads + q * 64 + 32, sizeof corner[1]);
+      rect(x + corner[0][0] * px, y + corner[0][1] * px, x + corner[1][0] * px, y + corner[1][1] * px, colour);
+    }
   }
 };
 }  // namespace
