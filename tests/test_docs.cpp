@@ -2,7 +2,8 @@
 // resolves, README.md's headline numbers equal the committed measurement files they come from
 // (examples/images/bench.csv, examples/images/footprint.csv, tools/fidelity/figures.csv,
 // tools/ref2d/figures.csv), and so do the documented sizes (the web page's files,
-// examples/web/size.csv; the firmware's footprint table); every chapter README under tools/ and
+// examples/web/size.csv; the firmware's footprint table) and the web page's step times
+// (examples/web/step_ratio.csv); every chapter README under tools/ and
 // examples/ keeps to its length. Runs in the repository root.
 #include <doctest/doctest.h>
 
@@ -466,6 +467,22 @@ TEST_CASE("docs: the web page's size is examples/web/size.csv")
   const std::string readme = read_text("README.md");
   const std::string page_kb = "a " + std::to_string((page + 500) / 1000) + " KB page";
   CHECK_MESSAGE(readme.find(page_kb) != std::string::npos, "README.md should say " << page_kb);
+}
+
+TEST_CASE("docs: the web page's step times are examples/web/step_ratio.csv")
+{
+  const std::string file = "examples/web/step_ratio.csv";
+  const auto rows = read_csv(file);
+  REQUIRE(rows.size() == 1);
+  const Row& r = rows[0];
+  // As bench.sh writes them: milliseconds to three decimals, the ratio to two.
+  const std::string times = r.at("native_ms") + " / " + r.at("chromium_ms") + " (" + r.at("ratio") + "x)";
+  const std::string chapter = read_text("examples/web/README.md");
+  CHECK_MESSAGE(chapter.find("| " + times + ", same state hash |") != std::string::npos,
+                "examples/web/README.md's table should say " << times);
+  CHECK_MESSAGE(chapter.find("median ms per step: native " + r.at("native_ms") + ", chromium " + r.at("chromium_ms") +
+                             ", ratio " + r.at("ratio")) != std::string::npos,
+                "examples/web/README.md's run should end in the medians of " << file);
 }
 
 TEST_CASE("docs: tests/README.md names every file of tests/")
