@@ -158,9 +158,9 @@ Scalar pair_radius(const WorldData<D>& w, const Body<D>& b, Scalar reach = 1)
 /// world whose shapes are all statistical with body-body data, their largest packing ratio
 /// (`Shape::largest_packing`, at most 1) with a margin. The impact pass's search takes such a
 /// pair as apart beyond that ratio times the sum of their bounding radii (`search_witness`), so
-/// the pairs the broad phase no longer lists are pairs that would never touch; a bunny's largest
-/// ratio is below 0.9, and a quarter of a pile's candidate pairs go. A plain sphere's ratio is 1,
-/// and a shape without a hull meets others at its collision sphere, which this does not bound.
+/// the pairs the broad phase no longer lists are pairs that would never touch (for the bunny,
+/// statsim/README.md). A plain sphere's ratio is 1, and a shape without a hull meets others at its
+/// collision sphere, which this does not bound.
 template <class FS = AllFeatures, int D>
 Scalar pair_reach(const WorldData<D>& w)
 {
