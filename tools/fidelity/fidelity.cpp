@@ -48,7 +48,7 @@
 //  - first_impact_ks: the tables describe a collision as everything from the first contact until
 //    the body has left the ground for good (a box landing on a corner strikes with a second and a
 //    third), and give the velocity and spin it leaves with. Each drop is measured at that event,
-//    whatever its step (FlightTop in fidelity.hpp): the first contact is the first step whose
+//    whatever its step (FlightTop in common/flight_top.hpp): the first contact is the first step whose
 //    vertical velocity rises by more than 2 g dt; a step is free when the velocity changed by
 //    gravity alone (within 1% of g dt); the collision ends at the first flight, after the first
 //    contact, that leaves fast enough to rise h (v_z^2 / (2 g) >= h, the bounces' h) and stays

@@ -1,9 +1,9 @@
-// See FlightTop in fidelity.hpp: the end of a drop's first collision, step by step.
-#include "fidelity/fidelity.hpp"
+// See flight_top.hpp.
+#include "common/flight_top.hpp"
 
 #include <cmath>
 
-namespace statsim::tools::fidelity {
+namespace statsim::tools {
 
 FlightTop::FlightTop(double dt, double min_rise, double gravity) : dt_(dt), min_rise_(min_rise), gravity_(gravity) {}
 
@@ -39,4 +39,4 @@ void FlightTop::add(const Eigen::Vector3d& velocity, const Eigen::Vector3d& spin
   }
 }
 
-}  // namespace statsim::tools::fidelity
+}  // namespace statsim::tools
