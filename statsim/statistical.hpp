@@ -106,7 +106,27 @@ Scalar kinetic_energy_per_mass(const SignatureView<D>& sig, const typename Space
 struct ResponseOutcome {
   bool applied = false;         ///< the body was approaching; v and w were replaced
   bool energy_clamped = false;  ///< the sample had more kinetic energy than the contact, and was scaled
+  bool stayed = false;          ///< the landing data kept the body on the plane (no normal velocity)
+  bool redrawn = false;         ///< the landing data had a response that would have stayed drawn again
 };
+
+/// The landing probability of a body striking the ground (`LandingView`: above 0, the extra
+/// probability that it stays; below 0, minus the probability that a response that would stay is
+/// drawn again), at cos theta `cos_theta`, spin ratio `spin_ratio` and Froude number `froude`:
+/// multilinear in the table's cells, clamped at its edges. 0 without landing data.
+inline Scalar landing_probability(const LandingView& landing, Scalar cos_theta, Scalar spin_ratio, Scalar froude)
+{
+  if (!landing.present()) return 0;
+  ResponseTableView table;
+  for (std::uint32_t a = 0; a < landing_axes; ++a) table.axes[a] = landing.axes[a];
+  table.axis_count = landing_axes;
+  table.components = 1;
+  table.mean = ValuesView(landing.probability);
+  const Scalar x[landing_axes] = {cos_theta, spin_ratio, froude};
+  Scalar p;
+  table.lookup(x, &p);
+  return p;
+}
 
 /// Table coordinates of a contact (paper 3.3.2 step 4), in the order of the table's axes.
 /// `v` is the velocity relative to the collision plane; it must approach it (v.n < 0).
@@ -208,10 +228,17 @@ inline void sample_response(const ResponseTableView& table, const Scalar* x, Pcg
 /// response down when it would leave more kinetic energy than the body brought to the contact.
 /// The normal part of the new velocity is kept non-negative: a sphere that still approached the
 /// plane would collide again at once.
+/// `gravity` (m/s^2) is the part of gravity that presses the body onto the plane, for a contact
+/// with a plane; 0 (the default, and for body-body contacts) or less leaves the landing data out.
+/// With landing data and gravity, a draw made before the response decides whether the body stays
+/// on the plane (`LandingView`): it then keeps the response's tangential velocity and leaves
+/// with no normal velocity and no spin; or, where the table's probability is negative, whether a
+/// response that would stay is drawn again. Without landing data no such draw is made, so older
+/// tables give the same bits as before.
 template <int D>
 ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename Space<D>::Rot& orientation,
                                      const typename Space<D>::Vec& n, typename Space<D>::Vec& v,
-                                     typename Space<D>::Spin& w, Pcg32& rng)
+                                     typename Space<D>::Spin& w, Pcg32& rng, Scalar gravity = 0)
 {
   using Vec = typename Space<D>::Vec;
   using Spin = typename Space<D>::Spin;
@@ -223,24 +250,53 @@ ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename
 
   Scalar x[max_response_axes];
   response_coordinates<D>(sig, frame, n, v, w, x);
-  constexpr int C = D == 3 ? 6 : 3;  // spin components, then velocity-offset components
-  Scalar sample[C];
-  STATSIM_ASSERT(sig.response.components == std::uint32_t(C));
-  sample_response(sig.response, x, rng, sample);
-
-  // Back to the world frame and to physical units: W+ = w_c |V-| / L, offset = dv_c |V-|.
-  Spin w_new;
-  Vec offset;
-  if constexpr (D == 3) {
-    w_new = frame.basis * Vector3(sample[0], sample[1], sample[2]) * (speed / sig.length);
-    offset = frame.basis * Vector3(sample[3], sample[4], sample[5]) * speed;
-  } else {
-    w_new = frame.mirror * sample[0] * (speed / sig.length);
-    offset = frame.basis * Vector2(sample[1], sample[2]) * speed;
+  // Landing data: one draw u before the response; p = the table's probability here. u < p keeps
+  // the body on the plane; u < -p draws again a response that would stay (rise below hop L).
+  const bool landing = sig.landing.present() && gravity > 0;
+  Scalar p = 0, u = 1;
+  if (landing) {
+    // x holds cos theta first and the spin ratio last (3D) or second (2D), whatever the layout.
+    const Scalar spin = D == 3 ? x[sig.layout == ResponseLayout::with_speed ? 3 : 2] : std::fabs(x[1]);
+    const Scalar froude = speed * speed / (gravity * sig.length);
+    p = landing_probability(sig.landing, x[0], spin, froude);
+    u = rng.uniform();
   }
-  Vec v_new = point_particle_velocity<D>(v, n, sig.material, sig.restitution_threshold) + offset;
-  const Scalar vn_new = v_new.dot(n);
-  if (vn_new < 0) v_new -= n * vn_new;
+  const bool stay = u < p;
+  constexpr int C = D == 3 ? 6 : 3;  // spin components, then velocity-offset components
+  STATSIM_ASSERT(sig.response.components == std::uint32_t(C));
+  const Vec v_particle = point_particle_velocity<D>(v, n, sig.material, sig.restitution_threshold);
+  Spin w_new;
+  Vec v_new;
+  // One draw of the tables, back to the world frame and to physical units: W+ = w_c |V-| / L,
+  // offset = dv_c |V-|.
+  const auto draw = [&]() {
+    Scalar sample[C];
+    sample_response(sig.response, x, rng, sample);
+    Vec offset;
+    if constexpr (D == 3) {
+      w_new = frame.basis * Vector3(sample[0], sample[1], sample[2]) * (speed / sig.length);
+      offset = frame.basis * Vector3(sample[3], sample[4], sample[5]) * speed;
+    } else {
+      w_new = frame.mirror * sample[0] * (speed / sig.length);
+      offset = frame.basis * Vector2(sample[1], sample[2]) * speed;
+    }
+    v_new = v_particle + offset;
+    const Scalar vn_new = v_new.dot(n);
+    if (vn_new < 0 || stay) v_new -= n * vn_new;
+    // The drawn spin belongs to the gravity-free flight the stay replaces; a body held down
+    // turns onto the ground instead, which the rest poses then steer.
+    if (stay) w_new = Spin(w_new * Scalar(0));
+  };
+  draw();
+  if (u < -p) {
+    // v_n^2 < 2 g hop L: the centre would rise less than hop L.
+    const Scalar vn_new = v_new.dot(n);
+    if (vn_new * vn_new < 2 * gravity * sig.landing.hop * sig.length) {
+      draw();
+      out.redrawn = true;
+    }
+  }
+  out.stayed = stay;
 
   // Energy guard: kinetic energy per unit mass, 1/2 |v|^2 + 1/2 w^T (I/m) w.
   const Scalar before = kinetic_energy_per_mass<D>(sig, orientation, v, w);

@@ -11,6 +11,7 @@
 #include "statsim/random.hpp"
 #include "statsim/signature.hpp"
 #include "statsim/signature_contact.hpp"
+#include "statsim/signature_landing.hpp"
 #include "statsim/signature_scale.hpp"
 #include "statsim/snapshot.hpp"
 #include "statsim/statistical.hpp"

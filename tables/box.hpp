@@ -17,18 +17,19 @@
 // Body-body: packing: 10 drop piles and 2 bins (walls 4.4 L apart) of 50 bodies in Bullet, seeds 1.., until all sleep (at most 20 s at 1/240 s; 11 of 12 all asleep; 15059 Bullet steps in all); 387 touching pairs
 // Body-body: packing d / the runtime's hull distance (find_hull_witness on this table, ratio 1): along faces 0.9978 (62), 0.9964 (59), 0.9992 (60), 0.9965 (71), 0.9965 (75), 0.9980 (53); along the line of centres 0-30 deg 0.9965 +- 0.0123 (0 pairs, pooled); 30-60 deg 0.9965 +- 0.0123 (3 pairs, pooled); 60-90 deg 0.9965 +- 0.0123 (4 pairs, pooled)
 // Body-body: support map i16 dequantization error 1.52e-06 m
+// Landing: 2304 impacts with gravity (24 per cell of cos theta x spin ratio x Froude number |V-|^2 / (g L)), a stay when the centre never rises 0.05 L before rest or 1 s; trials' stays 0.193, the response draws' 0.272, landing probability -0.681 (means over the cells above F = 0)
 #pragma once
 
 #include "statsim/signature.hpp"
 
 static_assert(STATSIM_TABLE_FORMAT_VERSION == 2, "tables/box.hpp was generated for table format 2: regenerate it with the command above");
-#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 1
-#error "tables/box.hpp needs table format 2.1 (body-body data): update statsim, or regenerate the table with --no-body-contacts"
+#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 2
+#error "tables/box.hpp needs table format 2.2 (landing data): update statsim, or regenerate the table with --no-landing"
 #endif
 
 namespace statsim::tables {
 
-inline constexpr SignatureQ16<3, 8, 4, 5, 8, 1, 6, 6, ContactDataQ16<3, 8, 17, 6>> box = {
+inline constexpr SignatureQ16<3, 8, 4, 5, 8, 1, 6, 6, ContactDataQ16<3, 8, 17, 6>, LandingData<4, 8, 4>> box = {
     "box",
     0x1.62b958p-3f,  // length L, m
     0x1.62b958p-3f,  // bounding radius, m
@@ -558,6 +559,47 @@ inline constexpr SignatureQ16<3, 8, 4, 5, 8, 1, 6, 6, ContactDataQ16<3, 8, 17, 6
       // packing along the line of centres (d / hull distance): mean, std at 0-30, 30-60, 60-90 deg
       {{0x1.fe35b6p-1f, 0x1.fe35b6p-1f, 0x1.fe35b6p-1f}},
       {{0x1.9365ep-7f, 0x1.9365ep-7f, 0x1.9365ep-7f}},
+    },
+    // landing data (statsim::LandingView): hop (over L); axes cos theta, spin ratio, Froude number; landing probability per cell (above 0: extra stays; below 0: stays drawn again)
+    {
+      0x1.99999ap-5f,
+      {{0x1.99999ap-4f, 0x1.99999ap-2f, 0x1.666666p-1f, 0x1p+0f}},
+      {{0x0p+0f, 0x1p-2f, 0x1p-1f, 0x1p+0f, 0x1p+1f, 0x1.8p+1f, 0x1.4p+2f, 0x1p+3f}},
+      {{0x0p+0f, 0x1p+0f, 0x1p+2f, 0x1p+4f}},
+      {{
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1.3d5762p-3f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1.141b12p-3f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, 0x1.e90322p-2f, -0x1.109ec8p-1f, 0x1.e4048ap-8f,
+        0x0p+0f, -0x1.c1ff44p-1f, -0x1.14e9a6p-2f, -0x1p+0f,
+        0x0p+0f, 0x1.555556p-3f, 0x1.2d60cp-5f, -0x1.461c5p-4f,
+        0x0p+0f, 0x1.bbd6cap-4f, 0x1.a41a42p-6f, -0x1p+0f,
+        0x0p+0f, -0x1.d559c2p-2f, -0x1.0e5a02p-1f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, 0x1.60fba2p-2f, 0x1.5f15f2p-4f, -0x1.5c1cbcp-2f,
+        0x0p+0f, 0x1.e1e1e2p-5f, -0x1.5fc372p-2f, 0x1.4fbcdap-4f,
+        0x0p+0f, 0x1.04a79p-3f, -0x1.df6bep-1f, -0x1.83414ap-3f,
+        0x0p+0f, 0x1.6b5ad6p-2f, -0x1.8992e4p-2f, -0x1.086948p-1f,
+        0x0p+0f, -0x1.b528f4p-1f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1.cf77cep-1f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1.b8e4e2p-1f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, 0x1.15f16p-1f, -0x1.7c5274p-1f, -0x1p+0f,
+        0x0p+0f, 0x1p+0f, -0x1.5ebc28p-1f, -0x1.283ecp-2f,
+        0x0p+0f, 0x1.f8fc7ep-4f, -0x1.3d12f2p-1f, -0x1p+0f,
+        0x0p+0f, 0x1.33f84cp-5f, -0x1.f7f366p-1f, -0x1p+0f,
+        0x0p+0f, -0x1.7a4cd8p-1f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1.246d78p-1f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1.d81a84p-1f, -0x1p+0f, -0x1p+0f,
+        0x0p+0f, -0x1p+0f, -0x1p+0f, -0x1p+0f
+      }},
     },
 };
 

@@ -148,6 +148,10 @@ HeaderNumbers loaded_numbers(const LoadedSignature3& loaded)
         add_floats(n, s.contact.faces);
         add_floats(n, std::vector<float>(s.contact.packing_mean.begin(), s.contact.packing_mean.end()));
         add_floats(n, std::vector<float>(s.contact.packing_stddev.begin(), s.contact.packing_stddev.end()));
+        if (s.landing.probability.empty()) return;
+        add_floats(n, std::vector<float>{s.landing.hop});
+        for (const auto* a : {&s.landing.cos_theta, &s.landing.spin_ratio, &s.landing.froude, &s.landing.probability})
+          add_floats(n, *a);
       },
       loaded.tables);
   return n;
@@ -402,7 +406,10 @@ TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run
     CHECK(v.restitution_threshold == box.restitution_threshold);
     // Bytes as stored: the i16 response tables take half.
     const std::size_t cells = 2 * 2 * 2, values = cells * 6;
-    const std::size_t fixed = 10 * 4 + 8 + 3 * 3 * 4 + (2 + 2 + 2 + 1) * 4 + v.rest.count * 5 * 4;
+    // Landing data: the hop, its axes (2 cos theta, 2 spin ratios, 4 Froude numbers) and a
+    // probability per cell, as floats.
+    const std::size_t landing = (1 + 2 + 2 + 4 + 2 * 2 * 4) * 4;
+    const std::size_t fixed = 10 * 4 + 8 + 3 * 3 * 4 + (2 + 2 + 2 + 1) * 4 + v.rest.count * 5 * 4 + landing;
     CHECK(s.bytes() == fixed + (s.i16() ? 2 * values * 2 + 16 : 2 * values * 4));
     if (s.i16()) {
       // A scale that is not the 16-bit rule's for the values would load other integers than the

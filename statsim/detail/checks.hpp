@@ -123,6 +123,17 @@ Status check_signature_layout(const SignatureView<D>& sig)
     return Status::invalid_shape;
   // Read by `mesh_to_world` only, but it is a count too (D (D + 1) numbers).
   if (sig.mesh_frame != nullptr && sig.mesh_frame.size < std::uint32_t(D * (D + 1))) return Status::invalid_shape;
+  // Landing data: one probability per cell of its three axes, exactly.
+  const LandingView& l = sig.landing;
+  if (l.present()) {
+    std::uint64_t landing_cells = 1;
+    for (const AxisView& a : l.axes) {
+      if (!readable(a)) return Status::invalid_shape;
+      landing_cells *= a.size;
+      if (landing_cells > 0x7fffffffu) return Status::invalid_shape;
+    }
+    if (l.probability.values == nullptr || l.probability.size != landing_cells) return Status::invalid_shape;
+  }
   const ContactView<D>& c = sig.contact;
   if (c.support_size == 0) return Status::ok;
   if (c.support_size < 2 || c.support_size > max_support_size || !readable(c.support)) return Status::invalid_shape;
@@ -182,6 +193,16 @@ Status check_signature_values(const SignatureView<D>& sig)
     if (bad(sig.rest.heights[i]) || !(sig.rest.heights[i] > 0)) return Status::invalid_shape;
     const Scalar f = sig.rest.frequencies[i];
     if (!(f >= 0 && f <= 1)) return Status::invalid_shape;  // NaN fails too
+  }
+  // Landing data: probabilities in [-1, 1]; the spin ratio and Froude axes not negative.
+  const LandingView& l = sig.landing;
+  if (l.present()) {
+    for (const AxisView& a : l.axes)
+      if (bad_axis(a)) return Status::invalid_shape;
+    if (!(l.axes[1].values[0] >= 0) || !(l.axes[2].values[0] >= 0)) return Status::invalid_shape;
+    if (!(l.hop >= 0) || bad(l.hop)) return Status::invalid_shape;
+    for (std::uint32_t i = 0; i < l.probability.size; ++i)
+      if (!(l.probability[i] >= -1 && l.probability[i] <= 1)) return Status::invalid_shape;  // NaN fails too
   }
   // Body-body data: support values are distances of the hull's farthest point along a direction
   // with a cube-face coordinate up to sqrt(3) (2D: sqrt(2)) long, so within that many bounding

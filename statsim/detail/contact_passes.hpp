@@ -112,7 +112,11 @@ void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, cons
     if (spin2 > cap * cap) b.angular_velocity = b.angular_velocity * (cap / std::sqrt(spin2));
   } else {
     Pcg32 rng = rng_of(w, b);
-    const ResponseOutcome o = statistical_response<D>(shape.signature, b.orientation, n, v, b.angular_velocity, rng);
+    // Against a plane, the part of gravity pressing the body onto it decides how often the
+    // body stays there (the signature's landing data); body-body contacts take none.
+    const Scalar gravity = ground_contact ? Scalar(-def.gravity.dot(n)) : Scalar(0);
+    const ResponseOutcome o =
+        statistical_response<D>(shape.signature, b.orientation, n, v, b.angular_velocity, rng, gravity);
     b.rng_state = rng.state();
     ctx.energy_clamps += o.energy_clamped;
     ctx.statistical_responses += o.applied;

@@ -9,6 +9,7 @@
 #include "ref3d/gather_body_contacts.hpp"
 #include "ref3d/reference_pool.hpp"
 #include "ref3d/sampling.hpp"
+#include "ref3d/signature_json.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -112,6 +113,13 @@ GatherResult gather(const GatherOptions& options)
 
   // 4. Body-body data.
   if (o.body_contacts) gather_body_contacts(r);
+
+  // 5. Landing data, against the tables as the runtime reads them (the JSON's, at the stored
+  // precision; it has no landing data yet).
+  if (o.landing && o.body_contacts) {  // a table holds landing data after its body-body data
+    const LoadedSignature3 tables = parse_signature_json(json_text(r, "landing stage"), "the gathered tables");
+    r.landing = gather_landing(o, pool, tables.view());
+  }
   return r;
 }
 

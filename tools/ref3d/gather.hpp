@@ -38,6 +38,7 @@
 #include "common/body_contacts.hpp"
 #include "ref3d/gather_checks.hpp"
 #include "ref3d/gather_emit.hpp"
+#include "ref3d/gather_landing.hpp"
 #include "ref3d/gather_options.hpp"
 #include "ref3d/gather_trials.hpp"
 #include "ref3d/response_fit.hpp"
@@ -63,6 +64,7 @@ struct GatherResult : ResponseFit, RestPoseFit {
   /// chose the table. Empty for a plain gathering.
   std::vector<std::string> notes;
   BodyContactData contact;  ///< when options.body_contacts
+  LandingFit landing;       ///< when options.landing
   // timings, s
   double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
 };

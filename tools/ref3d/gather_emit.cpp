@@ -25,6 +25,16 @@ std::string vec3(const Eigen::Vector3d& v, const char* f)
 
 namespace {
 
+// The mean over the landing cells that ran trials (Froude number above 0).
+double mean_of(const LandingFit& l, const std::vector<double>& v)
+{
+  double s = 0;
+  std::size_t n = 0;
+  for (std::size_t c = 0; c < v.size(); ++c)
+    if (l.froude[c % l.froude.size()] > 0) s += v[c], ++n;
+  return n == 0 ? 0.0 : s / static_cast<double>(n);
+}
+
 std::string hex64(std::uint64_t x)
 {
   char buf[32];
@@ -160,7 +170,17 @@ std::string header_text(const GatherResult& r, const std::string& command)
     contact_entries(c, o.i16, &error);
     if (o.i16) h << "// Body-body: support map i16 dequantization error " << fmt("%.3g", error) << " m\n";
   }
-  h << table_prologue(o.name, contact ? 1 : 0, o.target);
+  // Landing data (format 2.2) follows the body-body data in the initialiser, so it needs it.
+  const bool landing = contact && r.landing.present();
+  if (landing) {
+    const LandingFit& l = r.landing;
+    h << "// Landing: " << l.trials << " impacts with gravity (" << o.landing_trials
+      << " per cell of cos theta x spin ratio x Froude number |V-|^2 / (g L)), a stay when the centre never rises "
+      << num(l.hop) << " L before rest or " << num(o.landing_time) << " s; trials' stays "
+      << fmt("%.3f", mean_of(l, l.stays)) << ", the response draws' " << fmt("%.3f", mean_of(l, l.draw_stays))
+      << ", landing probability " << fmt("%.3f", mean_of(l, l.probability)) << " (means over the cells above F = 0)\n";
+  }
+  h << table_prologue(o.name, landing ? 2 : contact ? 1 : 0, o.target);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
                     a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
   h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
@@ -168,6 +188,10 @@ std::string header_text(const GatherResult& r, const std::string& command)
                             std::to_string(a1) + ", " + std::to_string(a2) + ", " + std::to_string(a3) + ", " +
                             std::to_string(r.rest.size()) + ", " + std::to_string(spread_size) +
                             (contact ? ", " + contact_type(c, o.i16) : std::string()) +
+                            (landing ? ", LandingData<" + std::to_string(r.landing.cos_theta.size()) + ", " +
+                                           std::to_string(r.landing.spin_ratio.size()) + ", " +
+                                           std::to_string(r.landing.froude.size()) + ">"
+                                     : std::string()) +
                             ">",
                         o.name, o.target);
   // Short arrays on one line, long ones 8 values a line (response tables 6, one cell; normals 3).
@@ -218,6 +242,16 @@ std::string header_text(const GatherResult& r, const std::string& command)
   h << table_entry(array(heights));
   h << table_entry(array(freqs));
   if (contact) h << contact_entries(c, o.i16);
+  if (landing) {
+    const LandingFit& l = r.landing;
+    h << table_comment("landing data (statsim::LandingView): hop (over L); axes cos theta, spin ratio, Froude number; "
+                       "landing probability per cell (above 0: extra stays; below 0: stays drawn again)");
+    h << "    {\n";
+    h << "      " << hex_float(l.hop) << ",\n";
+    for (const std::vector<double>* a : {&l.cos_theta, &l.spin_ratio, &l.froude, &l.probability})
+      h << "      " << hex_float_array(*a, ArrayStyle{a == &l.probability ? l.froude.size() : 8, 8, true, 6}) << ",\n";
+    h << "    },\n";
+  }
   h << table_epilogue(o.target);
   return h.str();
 }
@@ -345,6 +379,19 @@ std::string json_text(const GatherResult& r, const std::string& command)
                           {"piles_asleep", c.asleep},
                           {"pile_steps", c.pile_steps}};
   }
+  if (r.landing.present()) {
+    const LandingFit& l = r.landing;
+    j["landing"] = {{"hop", static_cast<double>(static_cast<float>(l.hop))},
+                    {"cos_theta", fl(l.cos_theta)},
+                    {"spin_ratio", fl(l.spin_ratio)},
+                    {"froude", fl(l.froude)},
+                    {"probability", fl(l.probability)},
+                    {"stays", l.stays},
+                    {"draw_stays", l.draw_stays},
+                    {"trials_per_cell", o.landing_trials},
+                    {"time", o.landing_time},
+                    {"trials", l.trials}};
+  }
   return j.dump(2) + "\n";
 }
 
@@ -376,6 +423,12 @@ std::string summary_text(const GatherResult& r)
       << fmt("%.4f", c.packing_mean[1]) << ", " << fmt("%.4f", c.packing_mean[2]) << " (" << c.packing_pairs[0] << ", "
       << c.packing_pairs[1] << ", " << c.packing_pairs[2] << " pairs; " << c.piles << " piles, " << c.bins << " bins, "
       << fmt("%.1f", c.packing_seconds) << " s)\n";
+  }
+  if (r.landing.present()) {
+    const LandingFit& l = r.landing;
+    s << "landing: " << l.trials << " impacts with gravity; stays " << fmt("%.3f", mean_of(l, l.stays))
+      << ", the response draws' " << fmt("%.3f", mean_of(l, l.draw_stays)) << ", landing probability "
+      << fmt("%.3f", mean_of(l, l.probability)) << " (means over the cells above F = 0; " << fmt("%.1f", l.seconds) << " s)\n";
   }
   if (r.options.i16) {
     const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));

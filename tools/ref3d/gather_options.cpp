@@ -54,6 +54,11 @@ std::vector<double> default_coarse_speeds()
   return {0.5, 1, 2, 4, 8};
 }
 
+std::vector<double> default_landing_froude()
+{
+  return {0, 1, 4, 16};
+}
+
 void validate_gather_options(const GatherOptions& o)
 {
   auto fail = [](const std::string& m) { throw std::runtime_error(m); };
@@ -96,6 +101,12 @@ void validate_gather_options(const GatherOptions& o)
   axis(o.cos_phi, "cos phi axis", -1, 1);
   axis(o.spin_ratios, "spin ratio axis", 0, 1e6);
   if (o.with_speed && !o.speeds.empty()) axis(o.speeds, "speed axis", 1e-3, 1e3);
+  if (o.landing) {
+    if (o.landing_trials < 1) fail("--landing-trials must be at least 1");
+    axis(o.landing_froude, "--landing-froude axis", 0, 1e6);
+    if (!(o.landing_hop >= 0 && o.landing_hop <= 1)) fail("--landing-hop must be in [0, 1]");
+    if (!(o.landing_time > 0 && o.landing_time <= 60)) fail("--landing-time must be in (0, 60] s");
+  }
   if (o.body_contacts) {
     if (o.support_size < 2 || o.support_size > static_cast<int>(max_support_size))
       fail("--support-size must be in [2, " + std::to_string(max_support_size) + "]");

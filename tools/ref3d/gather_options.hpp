@@ -21,6 +21,7 @@ std::vector<double> default_cos_phi();         ///< 10: -1 .. 1
 std::vector<double> default_spin_ratios();     ///< 16: 0 .. 8
 std::vector<double> default_paper_speeds();    ///< 26 speeds for --layout paper, m/s
 std::vector<double> default_coarse_speeds();   ///< the coarse speed axis, m/s
+std::vector<double> default_landing_froude();  ///< 4 Froude numbers |V-|^2 / (g L): 0, 1, 4, 16
 
 struct GatherOptions {
   std::string shape = "box";  ///< box, lshape, bunny (ignored when mesh_file is set)
@@ -59,6 +60,13 @@ struct GatherOptions {
   std::vector<double> spin_ratios = default_spin_ratios();
   std::vector<double> speeds;  ///< empty: default_paper_speeds() when with_speed
   ReferenceSettings reference;
+  // Landing data (5., statsim/signature_landing.hpp): a table of format 2.2; false
+  // (--no-landing), or without the body-body data it follows in a table: 2.1 or 2.0.
+  bool landing = true;
+  int landing_trials = 24;           ///< impacts with gravity per landing cell
+  std::vector<double> landing_froude = default_landing_froude();
+  double landing_hop = 0.05;         ///< rise over L below which an impact counts as a stay
+  double landing_time = 1.0;         ///< s: an impact not flown off by then counts as a stay
   // Body-body data (4.); false (--no-body-contacts): a table of format 2.0 without it.
   bool body_contacts = true;
   int support_size = 17;    ///< S of the support map (6 S^2 values)

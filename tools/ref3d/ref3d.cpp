@@ -58,6 +58,7 @@ struct GatherCommand {
   bool step_check = false;
   bool settings_check = false;
   bool no_body_contacts = false;
+  bool no_landing = false;
   std::vector<double> check_speeds = {0.5, 1, 2, 4, 8};
   int check_trials = 200;
   // --size-for-scene (tools/ref3d/sizing.hpp)
@@ -204,6 +205,8 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.response_model = parse_response_model(c.response_model);
     o.reference.mesh_hull = c.mesh_shape == "hull";
     o.body_contacts = !c.no_body_contacts;
+    // The landing data follows the body-body data in a table: a table of format 2.0 has neither.
+    o.landing = !c.no_landing && o.body_contacts;
     if (!c.units.empty() && !units_scale(c.units, o.mesh_scale))
       throw std::runtime_error("--units '" + c.units + "': expected m, cm, mm, in or ft");
     o.mesh_units_given = !c.units.empty() || sub.get_option("--scale")->count() > 0;
@@ -271,6 +274,9 @@ void run(const GatherCommand& c, const CLI::App& sub)
       other.options.response_model = options.response_model;
       other.options.empirical_outcomes = options.empirical_outcomes;
       other.options.i16 = options.i16;
+      // The landing probabilities correct the draws of the gathering's own model and precision:
+      // another model's draws stay otherwise, so its JSON leaves them out.
+      other.landing = LandingFit{};
       write_file_atomic(file, json_text(other, command + " (JSON of --response-model " +
                                                    response_model_name(options.response_model) + ")"));
     }
@@ -391,6 +397,17 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
       ->check(CLI::IsMember({"gimpact", "hull"}))
       ->capture_default_str();
   sub->add_option("--density", o.density, "Density, kg/m^3 (sets the recorded mass only)")->capture_default_str();
+  sub->add_flag("--no-landing", c->no_landing,
+                "Leave out the landing data (a table of format 2.1): how often a body striking the ground under "
+                "gravity stays on it, against the response tables' draws (statsim/signature_landing.hpp); "
+                "--no-body-contacts leaves it out too");
+  sub->add_option("--landing-trials", o.landing_trials, "Landing: impacts with gravity per cell (>= 1)")
+      ->capture_default_str();
+  axis_option("--landing-froude", o.landing_froude, "Landing axis: Froude numbers |V-|^2 / (g L), increasing, >= 0 (0: no trials, p = 0)");
+  sub->add_option("--landing-hop", o.landing_hop, "Landing: rise over L below which an impact counts as a stay")
+      ->capture_default_str();
+  sub->add_option("--landing-time", o.landing_time, "Landing: s after which an impact not flown off counts as a stay")
+      ->capture_default_str();
   sub->add_flag("--no-body-contacts", c->no_body_contacts,
                 "Leave out the body-body data (a table of format 2.0, as written before it existed)");
   sub->add_option("--support-size", o.support_size, "Body-body: support map nodes a side, S (6 S^2 values)")

@@ -16,7 +16,8 @@ namespace statsim::tools::ref3d {
 // TrialRng's `stream`, one per kind of trial, all here so that no two kinds share one (the
 // committed tables depend on each value). gather: heights, responses, rest drops, and the checks
 // (kCheckStream and kCheckStream + 1); gather-pairs: pair flights (kPairStream to
-// kPairStream + 3), their heights and the bins.
+// kPairStream + 3), their heights and the bins; the landing stage's impacts with gravity and
+// the runtime's draws at their contacts.
 constexpr std::uint64_t kHeightStream = 1;
 constexpr std::uint64_t kResponseStream = 2;
 constexpr std::uint64_t kRestStream = 3;
@@ -24,6 +25,8 @@ constexpr std::uint64_t kCheckStream = 5;
 constexpr std::uint64_t kPairStream = 11;
 constexpr std::uint64_t kPairHeightStream = 12;
 constexpr std::uint64_t kBinStream = 16;
+constexpr std::uint64_t kLandingStream = 20;
+constexpr std::uint64_t kLandingDrawStream = 21;
 
 /// xoshiro256** seeded through SplitMix64 from (seed, stream, index).
 class TrialRng {

@@ -170,6 +170,21 @@ void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::
     s.rest_heights.push_back(number(p, "height", origin, "rest[]."));
     s.rest_frequencies.push_back(number(p, "frequency", origin, "rest[]."));
   }
+
+  // Landing data (table format 2.2): optional; its values are checked by add_shape.
+  if (j.contains("landing")) {
+    const json& l = field(j, "landing", origin);
+    s.landing.hop = number(l, "hop", origin, "landing.");
+    s.landing.cos_theta = numbers(l, "cos_theta", origin, "landing.");
+    s.landing.spin_ratio = numbers(l, "spin_ratio", origin, "landing.");
+    s.landing.froude = numbers(l, "froude", origin, "landing.");
+    s.landing.probability = numbers(l, "probability", origin, "landing.");
+    if (s.landing.cos_theta.empty() || s.landing.spin_ratio.empty() || s.landing.froude.empty())
+      fail(origin, "a landing axis is empty");
+    expect_size(s.landing.probability,
+                s.landing.cos_theta.size() * s.landing.spin_ratio.size() * s.landing.froude.size(),
+                "landing.probability", origin);
+  }
   if (!j.contains("body_contacts")) return;
   s.mesh_frame = numbers(j, "mesh_frame", origin);
   expect_size(s.mesh_frame, 12, "mesh_frame", origin);
@@ -235,6 +250,10 @@ std::size_t signature_bytes(const SignatureView<3>& sig)
   const bool q16 = sig.response.mean.f32 == nullptr;
   bytes += q16 ? values * sizeof(std::int16_t) + 4 * f : values * f;
   bytes += sig.rest.count * (3 + 2) * f;  // normal, height, frequency
+  if (sig.landing.present()) {  // hop, axes, probabilities
+    bytes += f + sig.landing.probability.size * f;
+    for (const AxisView& a : sig.landing.axes) bytes += a.size * f;
+  }
   return bytes;
 }
 

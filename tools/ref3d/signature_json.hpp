@@ -13,6 +13,7 @@
 // SignatureQ16 header stores them. Tables of format 2.1 also give mesh_frame and body_contacts
 // {support_size, support, pair_mean, pair_stddev, faces, packing_mean, packing_stddev}; the
 // support map of an i16 table is quantised by statsim::quantize16 as the header stores it.
+// Tables of format 2.2 may give landing {hop, cos_theta, spin_ratio, froude, probability}.
 #pragma once
 
 #include "statsim/signature.hpp"
@@ -64,6 +65,11 @@ struct BasicLoadedSignature3 {
     std::vector<Scalar> faces;
     std::array<Scalar, 3> packing_mean{}, packing_stddev{};
   } contact;
+  /// Landing data (statsim::LandingView); `probability` empty when the JSON has none.
+  struct Landing {
+    Scalar hop = 0;
+    std::vector<Scalar> cos_theta, spin_ratio, froude, probability;
+  } landing;
 
   SignatureView<3> view() const { return signature_view<3>(*this); }
 };
