@@ -478,6 +478,26 @@ TEST_CASE("fidelity: a tiny run writes every key, and the reference against itse
   CHECK(j.at("methods").at("sphere").at("sample").at("statistical_responses").get<long long>() == 0);
   for (const char* k : {"no_flight", "not_rested_share", "mean_flight_speed", "mean_flight_spin"})
     CHECK(j.at("reference").contains(k));
+  // The time to rest split where a drop was last as fast as statsim's settle speed: every drop
+  // lands faster than that, and rests after it; onset and settling add up to the time to rest;
+  // the configurations count every drop once and the unrested ones apart.
+  for (const nlohmann::json* x : {&j.at("reference"), &stat.at("sample"), &j.at("methods").at("full").at("sample")}) {
+    const double onset = x->at("mean_settle_onset").get<double>();
+    const double settle = x->at("mean_settle_time").get<double>();
+    CHECK(onset > 0);
+    CHECK(settle > 0);
+    CHECK(onset + settle == doctest::Approx(x->at("mean_rest_time").get<double>()));
+    const nlohmann::json& by = x->at("settle_by_configuration");
+    REQUIRE(by.size() == x->at("rest_histogram").size());
+    long long drops = 0, not_rested = 0;
+    for (const nlohmann::json& c : by) {
+      drops += c.at("drops").get<long long>();
+      not_rested += c.at("not_rested").get<long long>();
+      CHECK((c.at("mean_settle_time").is_null() == (c.at("drops") == c.at("not_rested"))));
+    }
+    CHECK(drops == 8);
+    CHECK(not_rested == x->at("time_limited").get<long long>());
+  }
   // The same drops as the reference: every distance is 0, except rest_height_err (and with it
   // summary_error), which measures heights against the reference's mean height per configuration
   // and so keeps the reference's own spread about that mean.

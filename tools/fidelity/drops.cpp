@@ -1,6 +1,7 @@
 // Single drops of `statsim fidelity`: each run's initial state, the run to rest in one method,
 // and its rest configuration, travel, bounces and first-collision state.
 #include "fidelity/stages.hpp"
+#include "statsim/world_def.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -74,6 +75,7 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
   const long steps = static_cast<long>(std::ceil(limit / dt - 1e-9));
   double t = 0;
   bool rested = false;
+  const double settle_speed = double(WorldDef<3>{}.settle_speed);
   for (long k = 1; k <= steps; ++k) {
     sim->step();
     t = static_cast<double>(k) * dt;
@@ -91,6 +93,7 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
         if (z <= high - hysteresis) rising = false, low = z;
       }
     }
+    if (speed(s, R) >= settle_speed) out.settle_onset = t;
     const bool asleep = sim->body_asleep(0);
     const bool quiet = speed(s, R) < kQuietSpeed;
     if (asleep || quiet) {

@@ -102,6 +102,9 @@ struct DropRun {
   double travel = 0;           ///< horizontal distance drop point to rest point, m
   double bounces = 0;          ///< rises of the centre after the first contact (see the definitions)
   double rest_time = 0;        ///< s, when the rest condition began
+  /// s, the last time the drop moved at statsim's default `WorldDef::settle_speed` or faster
+  /// (centre, or farthest point by spin): where a statsim body would begin to settle; 0 if never
+  double settle_onset = 0;
   bool time_limited = false;   ///< reached the time limit before rest (did not rest)
   bool impact = false;         ///< a first contact was seen
   bool flight = false;         ///< a flight after the first contact was found (FlightTop::found)

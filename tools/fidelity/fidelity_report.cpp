@@ -7,6 +7,7 @@
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
 #include "common/plot.hpp"
+#include "statsim/world_def.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -123,6 +124,43 @@ json scenes_json(const std::vector<SceneResult>& scenes)
   return out;
 }
 
+// A drop's time to rest split where it would begin to settle in statsim (`DropRun::settle_onset`):
+// the time before it (flights, tumbling, sliding) and the settling after it, which in the
+// reference holds most of the rocking on curved backs. Over the drops that rested, as
+// rest_time_w1; by rest configuration, with the drops that did not rest counted apart.
+struct SettleSplit {
+  double onset = 0, settle = 0;  // s, means over the drops that rested
+  std::vector<std::size_t> drops, not_rested;
+  std::vector<double> settle_by_config;  // s, mean over the configuration's rested drops; -1 if none
+};
+
+SettleSplit settle_split(const std::vector<DropRun>& drops, int configs)
+{
+  const auto n = static_cast<std::size_t>(configs);
+  SettleSplit out;
+  out.drops.assign(n, 0);
+  out.not_rested.assign(n, 0);
+  std::vector<double> onset, settle, sums(n, 0.0);
+  for (const DropRun& r : drops) {
+    const auto c = static_cast<std::size_t>(r.config);
+    out.drops[c] += 1;
+    if (r.time_limited) {
+      out.not_rested[c] += 1;
+      continue;
+    }
+    onset.push_back(r.settle_onset);
+    settle.push_back(r.rest_time - r.settle_onset);
+    sums[c] += r.rest_time - r.settle_onset;
+  }
+  out.onset = mean(onset);
+  out.settle = mean(settle);
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::size_t rested = out.drops[c] - out.not_rested[c];
+    out.settle_by_config.push_back(rested ? sums[c] / static_cast<double>(rested) : -1.0);
+  }
+  return out;
+}
+
 json sample_json(const MethodResult& m, int configs)
 {
   json j;
@@ -151,6 +189,19 @@ json sample_json(const MethodResult& m, int configs)
   j["mean_travel"] = mean(travel);
   j["mean_bounces"] = mean(bounces);
   j["mean_rest_time"] = mean(rest_time);  // over the drops that rested
+  const SettleSplit split = settle_split(m.drops, configs);
+  j["mean_settle_onset"] = split.onset;
+  j["mean_settle_time"] = split.settle;
+  json by_config = json::array();
+  for (std::size_t c = 0; c < split.drops.size(); ++c) {
+    json x;
+    x["drops"] = split.drops[c];
+    x["not_rested"] = split.not_rested[c];
+    if (split.settle_by_config[c] >= 0) x["mean_settle_time"] = split.settle_by_config[c];
+    else x["mean_settle_time"] = nullptr;
+    by_config.push_back(x);
+  }
+  j["settle_by_configuration"] = by_config;
   j["mean_rest_height_over_R"] = mean(height);
   j["mean_flight_speed"] = mean(flight_speed);
   j["mean_flight_spin"] = mean(flight_spin);
@@ -430,6 +481,22 @@ std::string fidelity_table(const FidelityResult& r)
   counts(r.reference);
   counts(r.reference_b);
   for (const MethodResult& m : r.methods) counts(m);
+  // Where the time to rest goes: before the settle onset and after it, by rest configuration.
+  s << "\nTime to rest, split where statsim's default settle speed (" << num(double(WorldDef<3>{}.settle_speed), "%g")
+    << " m/s, centre or farthest point) was last reached; over the drops that rested; by configuration: mean "
+       "settling time in s (drops, not rested):\n";
+  auto split_line = [&](const std::string& name, const MethodResult& m) {
+    const SettleSplit sp = settle_split(m.drops, static_cast<int>(r.pose_labels.size()));
+    s << "- " << name << ": onset " << num(sp.onset, "%.2f") << " s, settling " << num(sp.settle, "%.2f") << " s;";
+    for (std::size_t c = 0; c < sp.drops.size(); ++c) {
+      s << (c ? ", " : " ") << c << ": " << (sp.settle_by_config[c] >= 0 ? num(sp.settle_by_config[c], "%.2f") : std::string("-"))
+        << " (" << sp.drops[c] << ", " << sp.not_rested[c] << ")";
+    }
+    s << "\n";
+  };
+  split_line("reference A", r.reference);
+  split_line("reference B", r.reference_b);
+  for (const MethodResult& m : r.methods) split_line(m.name, m);
   s << "\nReference settings:\n";
   for (const std::string& line : r.settings) s << "- " << line << "\n";
   s << "\nRest configurations: ";
