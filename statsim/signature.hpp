@@ -27,6 +27,7 @@
 #include "statsim/detail/response.hpp"
 #include "statsim/signature_contact.hpp"
 #include "statsim/signature_landing.hpp"
+#include "statsim/signature_settle.hpp"
 
 #include <array>
 #include <cstddef>
@@ -242,6 +243,9 @@ struct SignatureView {
   /// How often a body stays on the ground after an impact under gravity (3D tables of format
   /// 2.2); absent (`present()` false) in older tables and in 2D.
   LandingView landing;
+  /// How long a body settles in each rest pose (3D tables of format 2.3); absent (`present()`
+  /// false) in older tables and in 2D.
+  SettleView settle;
   /// Size of the shape over the size the table was gathered at (`scaled_view`); 1 for the
   /// table's own view. Every length above already includes it; a mesh point m of the table's
   /// mesh is the body point scale R (m - c).
@@ -275,6 +279,11 @@ template <class T, class = void>
 struct has_landing_data : std::false_type {};
 template <class T>
 struct has_landing_data<T, std::void_t<decltype(std::declval<const T&>().landing.probability)>> : std::true_type {};
+
+template <class T, class = void>
+struct has_settle_data : std::false_type {};
+template <class T>
+struct has_settle_data<T, std::void_t<decltype(std::declval<const T&>().settle.time)>> : std::true_type {};
 
 template <class T, class = void>
 struct has_mesh_frame : std::false_type {};
@@ -349,6 +358,14 @@ constexpr SignatureView<D> signature_view(const S& s)
       v.landing.hop = l.hop;
     }
   }
+  if constexpr (detail::has_settle_data<S>::value) {
+    const auto& t = s.settle.time;
+    if (t.size() > 0) {
+      v.settle.time = Span<const Scalar>(t);
+      v.settle.quantiles =
+          v.rest.count > 0 && t.size() % v.rest.count == 0 ? static_cast<std::uint32_t>(t.size() / v.rest.count) : 0;
+    }
+  }
   return v;
 }
 
@@ -368,12 +385,14 @@ constexpr std::array<Scalar, D*(D + 1)> identity_mesh_frame()
 /// response tables: `std::array<Scalar, N>` (`Signature`) or `Quantized16<N>` (`SignatureQ16`).
 ///   NH: height samples; A0..A3: response axis sizes (unused axes 1); NR: rest poses;
 ///   `Contact`: `ContactData`/`ContactDataQ16`, or `NoContactData`;
-///   `Landing`: `LandingData`, or `NoLandingData`.
-/// `mesh_frame` and `contact` are new in format 2.1 and `landing` in 2.2; all have defaults, so
+///   `Landing`: `LandingData`, or `NoLandingData`; `Settle`: `SettleData`, or `NoSettleData`.
+/// `mesh_frame` and `contact` are new in format 2.1, `landing` in 2.2 and `settle` in 2.3; all
+/// have defaults, so
 /// an older table (which initialises everything before them) still compiles and loads, without
 /// that data.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, class Means, class Spreads, class Contact = NoContactData, class Landing = NoLandingData>
+          std::uint32_t NR, class Means, class Spreads, class Contact = NoContactData, class Landing = NoLandingData,
+          class Settle = NoSettleData>
 struct BasicSignature {
   static constexpr std::uint32_t components = D == 3 ? 6 : 3;
   static constexpr std::uint32_t cells = A0 * A1 * A2 * A3;
@@ -404,6 +423,7 @@ struct BasicSignature {
   std::array<Scalar, D*(D + 1)> mesh_frame = detail::identity_mesh_frame<D>();  ///< see `SignatureView`
   Contact contact = {};
   Landing landing = {};
+  Settle settle = {};
 
   constexpr SignatureView<D> view() const { return signature_view<D>(*this); }
 };
@@ -413,17 +433,17 @@ struct BasicSignature {
 /// paper's model, one standard deviation per component).
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
           std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u), class Contact = NoContactData,
-          class Landing = NoLandingData>
+          class Landing = NoLandingData, class Settle = NoSettleData>
 using Signature = BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>,
-                                 std::array<Scalar, A0 * A1 * A2 * A3 * S>, Contact, Landing>;
+                                 std::array<Scalar, A0 * A1 * A2 * A3 * S>, Contact, Landing, Settle>;
 
 /// A signature whose response tables are 16-bit integers (one scale and offset per table), for
 /// firmware where flash is tight; made from a `Signature` by `quantize16`.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
           std::uint32_t NR, std::uint32_t S = (D == 3 ? 6u : 3u), class Contact = NoContactData,
-          class Landing = NoLandingData>
+          class Landing = NoLandingData, class Settle = NoSettleData>
 using SignatureQ16 = BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<A0 * A1 * A2 * A3 * (D == 3 ? 6u : 3u)>,
-                                    Quantized16<A0 * A1 * A2 * A3 * S>, Contact, Landing>;
+                                    Quantized16<A0 * A1 * A2 * A3 * S>, Contact, Landing, Settle>;
 
 // A signature's precision: `quantize16` turns a float table into its 16-bit form by the rule
 // every part of statsim uses, `dequantize` turns a 16-bit table back into floats as the runtime
@@ -472,16 +492,16 @@ constexpr void quantize16(const Scalar* values, std::size_t n, Scalar& scale, Sc
 /// tables is copied (body-body data too, in the precision it has). `inline constexpr auto t16 = statsim::quantize16(tables::box);` keeps only
 /// the 16-bit table in the program.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G>
-constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G> quantize16(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G, class T>
+constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G, T> quantize16(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G, T>& s)
 {
-  BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G> q{
+  BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G, T> q{
       s.name,        s.length,      s.bounding_radius, s.mass,         s.unit_inertia, s.material,
       s.restitution_threshold,      s.layout,          s.model,        s.axis_count,   s.height_axis,
       s.height_mean, s.height_stddev, s.axis0,         s.axis1,        s.axis2,        s.axis3,
       {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies,
-      s.mesh_frame,  s.contact,      s.landing};
+      s.mesh_frame,  s.contact,      s.landing,      s.settle};
   quantize16(s.response_mean.data(), s.response_mean.size(), q.response_mean.scale, q.response_mean.offset,
              q.response_mean.q.data());
   quantize16(s.response_spread.data(), s.response_spread.size(), q.response_spread.scale,
@@ -493,9 +513,9 @@ constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16
 /// A table already in 16-bit form stays as it is: `quantize16(tables::box)` holds whichever
 /// precision the committed table was generated with.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G>
-constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G>& quantize16(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G, class T>
+constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G, T>& quantize16(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G, T>& s)
 {
   return s;
 }
@@ -504,16 +524,16 @@ constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quant
 /// the runtime reads a 16-bit table, so both forms give a world the same values. For builds that
 /// need float tables (a test of the float path) from a table committed in 16 bits.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G>
-constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G> dequantize(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G, class T>
+constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G, T> dequantize(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16<NS>, C, G, T>& s)
 {
-  BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G> f{
+  BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G, T> f{
       s.name,        s.length,      s.bounding_radius, s.mass,         s.unit_inertia, s.material,
       s.restitution_threshold,      s.layout,          s.model,        s.axis_count,   s.height_axis,
       s.height_mean, s.height_stddev, s.axis0,         s.axis1,        s.axis2,        s.axis3,
       {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies,
-      s.mesh_frame,  s.contact,      s.landing};
+      s.mesh_frame,  s.contact,      s.landing,      s.settle};
   for (std::size_t i = 0; i < NM; ++i)
     f.response_mean[i] = s.response_mean.offset + s.response_mean.scale * Scalar(s.response_mean.q[i]);
   for (std::size_t i = 0; i < NS; ++i)
@@ -523,9 +543,9 @@ constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std:
 
 /// A float table stays as it is (see the 16-bit overload).
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
-          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G>
-constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G>& dequantize(
-    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G>& s)
+          std::uint32_t NR, std::size_t NM, std::size_t NS, class C, class G, class T>
+constexpr const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G, T>& dequantize(
+    const BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std::array<Scalar, NS>, C, G, T>& s)
 {
   return s;
 }

@@ -70,7 +70,7 @@ inline bool removed_slot(const BodySlots& s, std::uint32_t slot) { return !s.liv
 template <int D>
 bool keeps_step_start(const WorldData<D>& w, const Body<D>& b)
 {
-  return b.state != MotionState::asleep && b.slow_time != 0 && hull_contacts_on(w) &&
+  return b.state != MotionState::asleep && b.slow_time > 0 && hull_contacts_on(w) &&
          sleeps_from_anchor(w, b);
 }
 
@@ -229,7 +229,9 @@ Status check_snapshot_body(const WorldData<D>& w, const SnapshotBody<D>& r, cons
   if (!(b.radius >= limits::min_radius) || b.radius > limits::max_radius) return Status::invalid_radius;
   if (!shape.statistical && b.radius != shape.radius) return Status::invalid_radius;
   if (b.inv_mass < Scalar(1) / limits::max_mass || b.inv_mass > Scalar(1) / limits::min_mass) return Status::invalid_mass;
-  if (b.slow_time < 0 || b.rest_blend < 0 || b.rest_blend > 1) return Status::out_of_range;
+  // A negative slow time is a settling time still to run (`SettleView`), for a body in a pose.
+  if (b.slow_time < -max_settle_time || b.rest_blend < 0 || b.rest_blend > 1) return Status::out_of_range;
+  if (b.slow_time < 0 && b.rest_pose == no_rest_pose) return Status::invalid_snapshot;
   if (b.rest_pose != no_rest_pose && (!shape.statistical || b.rest_pose >= shape.signature.rest.count))
     return Status::invalid_snapshot;
   if (removed) {

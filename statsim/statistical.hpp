@@ -7,7 +7,9 @@
 #include "statsim/random.hpp"
 #include "statsim/signature.hpp"
 
+#include <cmath>
 #include <limits>
+#include <type_traits>
 
 namespace statsim {
 
@@ -461,6 +463,34 @@ inline Vector3 rest_turn(const Quaternion& orientation, const Vector3& rest_norm
 inline Scalar rest_turn(const Rot2& orientation, const Vector2& rest_normal, const Vector2& up, Scalar turn_time)
 {
   return detail::moment(Vector2(orientation * rest_normal), up) / turn_time;
+}
+
+/// A body's rocking about its rest pose while its settling time runs (`SettleView`): its spin,
+/// given `offset`, the rest turn with a turn time of 1 s (the axis that turns the pose into place,
+/// scaled by the sine of the angle left), the ground's normal `up`, the settling time left
+/// `left` (s), the rocking's angular frequency `omega` (rad/s) and its amplitude `amplitude`
+/// (rad), and the rest turn's `turn_time` (s).
+///
+/// The rest turn, offset / turn_time, keeps the body centred on its pose; on top of it the body
+/// rocks about a level axis with a spin of amplitude * omega that follows a triangle wave of
+/// period 2 pi / omega in the time left: a rock of about `amplitude` each way, whose spin is
+/// slow only for moments. With the amplitude at which the farthest point swings at the sleep
+/// speed the body rises no more than a few millimetres, and it is not still before its time is
+/// over, as the reference's bodies rock in their pose. A triangle wave, not a sine: floor and
+/// products only, so the same bits on every platform.
+template <class Spin, class Up>
+Spin settle_rock(const Spin& offset, const Up& up, Scalar left, Scalar omega, Scalar amplitude, Scalar turn_time)
+{
+  constexpr Scalar two_pi = Scalar(6.283185307179586);
+  const Scalar cycles = left * (omega / two_pi);
+  const Scalar f = cycles - std::floor(cycles);
+  const Scalar wave = 4 * std::fabs(f - Scalar(0.5)) - 1;  // -1 .. 1
+  const Scalar swing = amplitude * omega * wave;
+  if constexpr (std::is_same<Spin, Scalar>::value) {
+    return offset / turn_time + swing;
+  } else {
+    return offset / turn_time + detail::any_perpendicular(up) * swing;
+  }
 }
 
 /// The orientation turned by the smallest rotation that makes `rest_normal` point exactly `up`.

@@ -12,6 +12,7 @@
 #include "statsim/signature.hpp"
 #include "statsim/signature_contact.hpp"
 #include "statsim/signature_landing.hpp"
+#include "statsim/signature_settle.hpp"
 #include "statsim/signature_scale.hpp"
 #include "statsim/snapshot.hpp"
 #include "statsim/statistical.hpp"

@@ -364,7 +364,9 @@ struct Body {
   Vec step_start;
   Scalar radius;                          ///< current collision radius, m
   Scalar inv_mass;                        ///< 1/kg
-  Scalar slow_time;                       ///< s spent slow and touching
+  /// s spent slow and touching; below 0, minus the settling time a body in its rest pose has
+  /// still to rock before it may be still (tables with settling data, `SettleView`)
+  Scalar slow_time;
   Scalar rest_blend;                      ///< 0: radius is h_coll; 1: radius is h_rest of rest_pose
   Word64 rng_state;                       ///< state of the body's PCG32 stream
   // Bit-fields: they read and assign as plain fields, but cannot be bound to a reference. In 2D

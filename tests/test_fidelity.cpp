@@ -152,6 +152,7 @@ HeaderNumbers loaded_numbers(const LoadedSignature3& loaded)
         add_floats(n, std::vector<float>{s.landing.hop});
         for (const auto* a : {&s.landing.cos_theta, &s.landing.spin_ratio, &s.landing.froude, &s.landing.probability})
           add_floats(n, *a);
+        add_floats(n, s.settle.time);
       },
       loaded.tables);
   return n;
@@ -379,7 +380,7 @@ TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run
     const int rc = run_gather_command(
         {"--shape", "box", "--name", "tinybox", "--cos-theta", "0.5,1", "--cos-phi", "-1,1", "--spin-ratios", "0,1",
          "--height-ratios", "0,1,4", "--trials", "3", "--height-trials", "8", "--rest-drops", "24", "--threads", "2",
-         "--precision", precision, "--out", hpp, "--json", js, "--quiet"},
+         "--precision", precision, "--out", hpp, "--json", js, "--settle", "--quiet"},
         out, err);
     INFO(err.str());
     REQUIRE(rc == 0);
@@ -409,7 +410,11 @@ TEST_CASE("fidelity: the JSON of a gathering loads as the header of the same run
     // Landing data: the hop, its axes (2 cos theta, 2 spin ratios, 4 Froude numbers) and a
     // probability per cell, as floats.
     const std::size_t landing = (1 + 2 + 2 + 4 + 2 * 2 * 4) * 4;
-    const std::size_t fixed = 10 * 4 + 8 + 3 * 3 * 4 + (2 + 2 + 2 + 1) * 4 + v.rest.count * 5 * 4 + landing;
+    // Settling data: 8 quantiles a rest pose, as floats.
+    REQUIRE(v.settle.present());
+    const std::size_t settle = v.rest.count * 8 * 4;
+    const std::size_t fixed =
+        10 * 4 + 8 + 3 * 3 * 4 + (2 + 2 + 2 + 1) * 4 + v.rest.count * 5 * 4 + landing + settle;
     CHECK(s.bytes() == fixed + (s.i16() ? 2 * values * 2 + 16 : 2 * values * 4));
     if (s.i16()) {
       // A scale that is not the 16-bit rule's for the values would load other integers than the

@@ -77,6 +77,13 @@ struct HeapTable {
     std::vector<Scalar> faces;
     std::array<Scalar, 3> packing_mean{}, packing_stddev{};
   } contact;
+  struct {
+    Scalar hop = 0;
+    std::vector<Scalar> cos_theta, spin_ratio, froude, probability;
+  } landing;
+  struct {
+    std::vector<Scalar> time;
+  } settle;
 
   SignatureView<D> view() const { return signature_view<D>(*this); }
 };
@@ -117,6 +124,14 @@ auto copy_to_heap(const T& t)
     h.contact.packing_mean = t.contact.packing_mean;
     h.contact.packing_stddev = t.contact.packing_stddev;
   }
+  if constexpr (detail::has_landing_data<T>::value) {
+    h.landing.hop = t.landing.hop;
+    h.landing.cos_theta = on_heap(t.landing.cos_theta);
+    h.landing.spin_ratio = on_heap(t.landing.spin_ratio);
+    h.landing.froude = on_heap(t.landing.froude);
+    h.landing.probability = on_heap(t.landing.probability);
+  }
+  if constexpr (detail::has_settle_data<T>::value) h.settle.time = on_heap(t.settle.time);
   return h;
 }
 
@@ -196,6 +211,9 @@ void expect_overstated_counts_refused(const T& table)
     short_arrays.push_back({"pair distance stddev", [](Heap& h) { drop_last(h.contact.pair_stddev); }});
     short_arrays.push_back({"support map", [](Heap& h) { drop_last(h.contact.support); }});
   }
+  if (valid.landing.present())
+    short_arrays.push_back({"landing probabilities", [](Heap& h) { drop_last(h.landing.probability); }});
+  if (valid.settle.present()) short_arrays.push_back({"settling times", [](Heap& h) { drop_last(h.settle.time); }});
   for (const auto& s : short_arrays) {
     CAPTURE(s.first);
     Heap spoilt = heap;

@@ -134,6 +134,12 @@ Status check_signature_layout(const SignatureView<D>& sig)
     }
     if (l.probability.values == nullptr || l.probability.size != landing_cells) return Status::invalid_shape;
   }
+  // Settling data: the same number of quantiles for every rest pose, and no more than a table
+  // holds (`max_settle_quantiles`).
+  const SettleView& t = sig.settle;
+  if (t.present() && (t.time.values == nullptr || t.quantiles == 0 || t.quantiles > max_settle_quantiles ||
+                      std::uint64_t(t.quantiles) * rest.count != t.time.size))
+    return Status::invalid_shape;
   const ContactView<D>& c = sig.contact;
   if (c.support_size == 0) return Status::ok;
   if (c.support_size < 2 || c.support_size > max_support_size || !readable(c.support)) return Status::invalid_shape;
@@ -203,6 +209,14 @@ Status check_signature_values(const SignatureView<D>& sig)
     if (!(l.hop >= 0) || bad(l.hop)) return Status::invalid_shape;
     for (std::uint32_t i = 0; i < l.probability.size; ++i)
       if (!(l.probability[i] >= -1 && l.probability[i] <= 1)) return Status::invalid_shape;  // NaN fails too
+  }
+  // Settling data: times in [0, max_settle_time] s, non-decreasing within each pose (quantiles).
+  const SettleView& t = sig.settle;
+  if (t.present()) {
+    for (std::uint32_t i = 0; i < t.time.size; ++i) {
+      if (!(t.time.values[i] >= 0 && t.time.values[i] <= max_settle_time)) return Status::invalid_shape;  // NaN too
+      if (i % t.quantiles != 0 && !(t.time.values[i] >= t.time.values[i - 1])) return Status::invalid_shape;
+    }
   }
   // Body-body data: support values are distances of the hull's farthest point along a direction
   // with a cube-face coordinate up to sqrt(3) (2D: sqrt(2)) long, so within that many bounding

@@ -301,7 +301,7 @@ bool wakes_by_overlap(const WorldData<D>& w, const Body<D>& a, const Body<D>& b,
 {
   if (!(depth > hull_wake_overlap * reach) || !hull_pair<FS>(w, a, b)) return false;
   const Body<D>& presser = a.state == MotionState::asleep ? b : a;
-  return depth > 2 * hull_wake_overlap * reach || presser.slow_time == 0 || squared_norm(presser.angular_velocity) > 0;
+  return depth > 2 * hull_wake_overlap * reach || presser.slow_time <= 0 || squared_norm(presser.angular_velocity) > 0;
 }
 
 /// The unit line of centres `e` and the distance of two bodies `d` apart (b - a); false when

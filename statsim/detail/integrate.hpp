@@ -27,7 +27,7 @@ std::uint32_t integrate(WorldData<D>& w, Scalar dt, Own&& own)
     Body<D>& b = w.bodies[i];
     // The sleep test may measure from where the body's slow time began (`sleeps_from_anchor`):
     // the centre is kept there while the clock runs.
-    if (b.slow_time == 0 || !hulls || !sleeps_from_anchor<FS>(w, b)) b.step_start = b.position;
+    if (b.slow_time <= 0 || !hulls || !sleeps_from_anchor<FS>(w, b)) b.step_start = b.position;
     ++count;
     if (own(i)) return;
     b.linear_velocity = (b.linear_velocity + dv) * lin_damp;

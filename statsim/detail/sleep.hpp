@@ -81,7 +81,11 @@ void update_radii(WorldData<D>& w)
 /// Resting conditions (paper 3.4): a statistical body settling on the ground picks the rest
 /// pose nearest to its orientation relative to the ground's normal `ground` and blends its
 /// radius toward that pose's height; a body that speeds up again blends back and forgets the
-/// pose; a body briefly off the ground keeps it.
+/// pose; a body briefly off the ground keeps it. With settling data (`SettleView`) the body
+/// draws, as it picks its pose, how long it settles there: `slow_time` counts up from minus that
+/// time (`update_motion_states`), and while it is negative the body rocks about the pose
+/// (`settle_rock`) and cannot be still. Times scale with the square root of the shape's scale,
+/// as a period of rocking under gravity does.
 template <class FS, int D>
 void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground, bool settling_on_bodies, bool fast,
                       Scalar dt, const typename Space<D>::Vec& ground)
@@ -98,6 +102,13 @@ void update_rest_pose(const WorldData<D>& w, Body<D>& b, bool settling_on_ground
       const std::uint32_t pose = nearest_rest_pose<D>(shape.signature, b.orientation, ground, shape.rest_bias.data());
       if (pose >= shape.signature.rest.count) return;  // only with a non-finite orientation
       b.rest_pose = std::uint8_t(pose);
+      const SettleView& settle = shape.signature.settle;
+      if (settle.present()) {
+        Pcg32 rng = rng_of(w, b);
+        const Scalar time = settle.at(pose, rng.uniform()) * std::sqrt(shape.signature.scale);
+        b.rng_state = rng.state();
+        b.slow_time = -time;
+      }
     }
     b.pile_rest = false;
     b.rest_blend = b.rest_blend + step < 1 ? b.rest_blend + step : Scalar(1);
@@ -245,6 +256,28 @@ void update_motion_states(WorldData<D>& w, Scalar dt, std::uint32_t touching)
     const bool tipping = slope == SlopeSettle::tipping;
     update_rest_pose<FS>(w, b, settling && b.on_ground && slope == SlopeSettle::pose, settling && !b.on_ground,
                      speed2 >= settle2, dt, ground);
+    // Its settling time runs (a negative slow time, `update_rest_pose`): it rocks, and is not
+    // still before the time is over. The time runs once the body is within the snap angle of its
+    // pose: the turn toward it moves the farthest point at the settle speed, and the reference's
+    // settling was timed from the last moment at that speed. A rock that lifts it off the ground
+    // for a step keeps the clock; only speed stops it.
+    if (b.slow_time < 0 && b.rest_pose == no_rest_pose) b.slow_time = 0;  // a slope took its pose away
+    if (b.slow_time < 0 && speed2 < settle2) {
+      b.state = settling ? MotionState::settling : MotionState::moving;
+      // One that other bodies hold out of its pose (on its hull, `hull_radius`) cannot reach it:
+      // its time runs too, or it would never sleep.
+      const bool on_ground = settling && b.on_ground;
+      if (!on_ground || in_rest_pose(w, b, ground) || hull_radius<FS>(w, b, ground) > b.radius)
+        b.slow_time = b.slow_time + dt < 0 ? b.slow_time + dt : Scalar(0);
+      if (b.slow_time < 0) return;
+    }
+    // Its time is over (settling data): it stops exactly in its pose once within the snap angle
+    // (as it would on falling asleep), not a few degrees off it while it waits out its sleep time.
+    if (settling && b.on_ground && slope == SlopeSettle::pose && b.rest_pose != no_rest_pose &&
+        w.shapes[b.shape].signature.settle.present() && in_rest_pose(w, b, ground)) {
+      b.orientation = snap_to_rest(b.orientation, w.shapes[b.shape].signature.rest.normal(b.rest_pose), ground);
+      b.angular_velocity = Space<D>::zero_spin();
+    }
     if (!settling) {
       b.state = MotionState::moving;
       b.slow_time = 0;

@@ -71,16 +71,30 @@ std::uint64_t signature_hash(const SignatureView<D>& sig)
     h.add(sig.rest.heights[i]);
     h.add(sig.rest.frequencies[i]);
   }
-  // Body-body data, when the table has it (a table without it hashes as before).
+  // Body-body data, landing data and settling data, each when the table has it (a table
+  // without them hashes as before).
   const ContactView<D>& c = sig.contact;
-  if (!c.present()) return h.value;
-  h.add_all(c.support_size, c.face_count);
-  hash_values(h, c.support, c.support_count());
-  for (std::uint32_t i = 0; i < c.face_count * face_values(D); ++i) h.add(c.faces[i]);
-  if (c.offset_scale != 1) h.add(c.offset_scale);  // a shape of another size (a table's own hashes as before)
-  for (std::size_t k = 0; k < 3; ++k) h.add_all(c.packing_mean[k], c.packing_stddev[k]);
-  if (c.pair_mean != nullptr)
-    for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i) h.add_all(c.pair_mean[i], c.pair_stddev[i]);
+  if (c.present()) {
+    h.add_all(c.support_size, c.face_count);
+    hash_values(h, c.support, c.support_count());
+    for (std::uint32_t i = 0; i < c.face_count * face_values(D); ++i) h.add(c.faces[i]);
+    if (c.offset_scale != 1) h.add(c.offset_scale);  // a shape of another size (a table's own hashes as before)
+    for (std::size_t k = 0; k < 3; ++k) h.add_all(c.packing_mean[k], c.packing_stddev[k]);
+    if (c.pair_mean != nullptr)
+      for (std::uint32_t i = 0; i < sig.height.spin_ratio.size; ++i) h.add_all(c.pair_mean[i], c.pair_stddev[i]);
+  }
+  const LandingView& l = sig.landing;
+  if (l.present()) {
+    h.add(l.hop);
+    for (const AxisView& a : l.axes) hash_axis(h, a);
+    for (std::uint32_t i = 0; i < l.probability.size; ++i) h.add(l.probability[i]);
+  }
+  const SettleView& t = sig.settle;
+  if (t.present()) {
+    h.add(t.quantiles);
+    for (std::uint32_t i = 0; i < t.time.size; ++i) h.add(t.time.values[i]);
+    if (sig.scale != 1) h.add(sig.scale);  // settling times scale with the shape (`update_rest_pose`)
+  }
   return h.value;
 }
 

@@ -228,7 +228,7 @@ constexpr Scalar island_wait = 4;
 template <int D>
 bool joins_island(const WorldData<D>& w, const Body<D>& b, const Body<D>& s)
 {
-  return s.state == MotionState::asleep && b.state != MotionState::asleep && b.slow_time == 0 &&
+  return s.state == MotionState::asleep && b.state != MotionState::asleep && b.slow_time <= 0 &&
          s.slow_time < island_wait * w.def.sleep_time && !bit_set(w.flagged, std::uint32_t(&s - w.bodies));
 }
 

@@ -1,6 +1,6 @@
 // The gathering of `statsim gather` (see gather.hpp): runs the stages in order, each on the
 // options' worker threads: h_coll flights, response trials and their fit, rest drops and their
-// poses, the body-body data.
+// poses, the body-body data, the landing data and the settling data.
 #include "ref3d/gather.hpp"
 
 #include "common/parallel.hpp"
@@ -93,11 +93,11 @@ GatherResult gather(const GatherOptions& options)
     r.response_seconds = seconds_since(t0);
   }
 
-  // 3. Rest poses.
+  // 3. Rest poses (the drops are kept for the settling data).
+  std::vector<DropTrial> drops(static_cast<std::size_t>(o.rest_drops));
   {
     const auto t0 = std::chrono::steady_clock::now();
-    const std::size_t n = static_cast<std::size_t>(o.rest_drops);
-    std::vector<DropTrial> drops(n);
+    const std::size_t n = drops.size();
     Progress progress("rest drops", n, o.progress);
     parallel_for(
         n,
@@ -120,6 +120,9 @@ GatherResult gather(const GatherOptions& options)
     const LoadedSignature3 tables = parse_signature_json(json_text(r, "landing stage"), "the gathered tables");
     r.landing = gather_landing(o, pool, tables.view());
   }
+
+  // 6. Settling data, from the rest drops of 3. (a table holds it after its landing data).
+  if (o.settle && o.landing && o.body_contacts) r.settle = fit_settle(drops, r.rest, o);
   return r;
 }
 

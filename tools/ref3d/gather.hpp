@@ -40,6 +40,7 @@
 #include "ref3d/gather_emit.hpp"
 #include "ref3d/gather_landing.hpp"
 #include "ref3d/gather_options.hpp"
+#include "ref3d/gather_settle.hpp"
 #include "ref3d/gather_trials.hpp"
 #include "ref3d/response_fit.hpp"
 #include "ref3d/rest_poses.hpp"
@@ -65,6 +66,7 @@ struct GatherResult : ResponseFit, RestPoseFit {
   std::vector<std::string> notes;
   BodyContactData contact;  ///< when options.body_contacts
   LandingFit landing;       ///< when options.landing
+  SettleFit settle;         ///< when options.settle (and the landing data it follows)
   // timings, s
   double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
 };

@@ -180,7 +180,18 @@ std::string header_text(const GatherResult& r, const std::string& command)
       << fmt("%.3f", mean_of(l, l.stays)) << ", the response draws' " << fmt("%.3f", mean_of(l, l.draw_stays))
       << ", landing probability " << fmt("%.3f", mean_of(l, l.probability)) << " (means over the cells above F = 0)\n";
   }
-  h << table_prologue(o.name, landing ? 2 : contact ? 1 : 0, o.target);
+  // Settling data (format 2.3) follows the landing data in the initialiser, so it needs it.
+  const bool settle = landing && r.settle.present();
+  if (settle) {
+    const SettleFit& t = r.settle;
+    h << "// Settling: the " << o.rest_drops << " rest drops (" << t.time_limited
+      << " at the time limit, counted with the time they had), each from its last step at " << num(t.settle_speed)
+      << " m/s or faster (centre, or farthest point by spin) to staying below " << num(t.quiet_speed) << " m/s; "
+      << t.quantiles << " quantiles per rest pose; drops and mean settling time per pose:";
+    for (std::size_t i = 0; i < t.drops.size(); ++i) h << " " << t.drops[i] << " " << fmt("%.3f", t.mean[i]) << " s;";
+    h << "\n";
+  }
+  h << table_prologue(o.name, settle ? 3 : landing ? 2 : contact ? 1 : 0, o.target);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
                     a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
   h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
@@ -192,6 +203,9 @@ std::string header_text(const GatherResult& r, const std::string& command)
                                            std::to_string(r.landing.spin_ratio.size()) + ", " +
                                            std::to_string(r.landing.froude.size()) + ">"
                                      : std::string()) +
+                            (settle ? ", SettleData<" + std::to_string(r.rest.size()) + ", " +
+                                          std::to_string(r.settle.quantiles) + ">"
+                                    : std::string()) +
                             ">",
                         o.name, o.target);
   // Short arrays on one line, long ones 8 values a line (response tables 6, one cell; normals 3).
@@ -250,6 +264,14 @@ std::string header_text(const GatherResult& r, const std::string& command)
     h << "      " << hex_float(l.hop) << ",\n";
     for (const std::vector<double>* a : {&l.cos_theta, &l.spin_ratio, &l.froude, &l.probability})
       h << "      " << hex_float_array(*a, ArrayStyle{a == &l.probability ? l.froude.size() : 8, 8, true, 6}) << ",\n";
+    h << "    },\n";
+  }
+  if (settle) {
+    const SettleFit& t = r.settle;
+    h << table_comment("settling data (statsim::SettleView): per rest pose, in their order, the settling time (s) "
+                       "at the probabilities (k + 1/2) / " + std::to_string(t.quantiles));
+    h << "    {\n";
+    h << "      " << hex_float_array(t.time, ArrayStyle{static_cast<std::size_t>(t.quantiles), 8, true, 6}) << ",\n";
     h << "    },\n";
   }
   h << table_epilogue(o.target);
@@ -392,6 +414,16 @@ std::string json_text(const GatherResult& r, const std::string& command)
                     {"time", o.landing_time},
                     {"trials", l.trials}};
   }
+  if (r.settle.present()) {
+    const SettleFit& t = r.settle;
+    j["settle"] = {{"quantiles", t.quantiles},
+                   {"time", fl(t.time)},
+                   {"settle_speed", t.settle_speed},
+                   {"quiet_speed", t.quiet_speed},
+                   {"drops", t.drops},
+                   {"mean", t.mean},
+                   {"time_limited", t.time_limited}};
+  }
   return j.dump(2) + "\n";
 }
 
@@ -429,6 +461,13 @@ std::string summary_text(const GatherResult& r)
     s << "landing: " << l.trials << " impacts with gravity; stays " << fmt("%.3f", mean_of(l, l.stays))
       << ", the response draws' " << fmt("%.3f", mean_of(l, l.draw_stays)) << ", landing probability "
       << fmt("%.3f", mean_of(l, l.probability)) << " (means over the cells above F = 0; " << fmt("%.1f", l.seconds) << " s)\n";
+  }
+  if (r.settle.present()) {
+    const SettleFit& t = r.settle;
+    s << "settling: " << r.options.rest_drops << " rest drops (" << t.time_limited << " at the time limit), "
+      << t.quantiles << " quantiles per pose; mean settling time per pose";
+    for (std::size_t i = 0; i < t.mean.size(); ++i) s << (i == 0 ? " " : ", ") << fmt("%.3f", t.mean[i]);
+    s << " s (" << fmt("%.1f", t.seconds) << " s)\n";
   }
   if (r.options.i16) {
     const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(r.response_std));

@@ -107,6 +107,13 @@ void validate_gather_options(const GatherOptions& o)
     if (!(o.landing_hop >= 0 && o.landing_hop <= 1)) fail("--landing-hop must be in [0, 1]");
     if (!(o.landing_time > 0 && o.landing_time <= 60)) fail("--landing-time must be in (0, 60] s");
   }
+  if (o.settle) {
+    if (o.settle_quantiles < 1 || o.settle_quantiles > static_cast<int>(max_settle_quantiles))
+      fail("--settle-quantiles must be in [1, " + std::to_string(max_settle_quantiles) + "]");
+    if (!(o.settle_speed > 0) || !std::isfinite(o.settle_speed)) fail("--settle-speed must be positive (m/s)");
+    if (!(o.quiet_speed > 0 && o.quiet_speed < o.settle_speed))
+      fail("--quiet-speed must be positive and below --settle-speed (" + num(o.settle_speed) + " m/s)");
+  }
   if (o.body_contacts) {
     if (o.support_size < 2 || o.support_size > static_cast<int>(max_support_size))
       fail("--support-size must be in [2, " + std::to_string(max_support_size) + "]");

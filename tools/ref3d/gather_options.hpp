@@ -1,12 +1,14 @@
 // The options of `statsim gather` (the shape, the axes, the trials, the reference's settings,
-// the body-body data) with their defaults and checks, and the shape they name. Every stage of the
-// gathering reads them; tools/ref3d/README.md documents the command line that sets them.
+// the body-body, landing and settling data) with their defaults and checks, and the shape they
+// name. Every stage of the gathering reads them; tools/ref3d/README.md documents the command
+// line that sets them.
 #pragma once
 
 #include "common/table_writer.hpp"
 #include "ref3d/model.hpp"
 #include "ref3d/reference.hpp"
 #include "statsim/signature.hpp"
+#include "statsim/world_def.hpp"
 
 #include <cstdint>
 #include <string>
@@ -67,6 +69,14 @@ struct GatherOptions {
   std::vector<double> landing_froude = default_landing_froude();
   double landing_hop = 0.05;         ///< rise over L below which an impact counts as a stay
   double landing_time = 1.0;         ///< s: an impact not flown off by then counts as a stay
+  // Settling data (6., statsim/signature_settle.hpp, gather_settle.hpp): a table of format 2.3,
+  // when asked for (--settle) and with the landing data it follows in a table.
+  bool settle = false;
+  int settle_quantiles = 8;  ///< quantiles of the settling time per rest pose
+  /// m/s: the last time a drop was this fast starts its settling time; the runtime's default, at
+  /// which it starts settling a body.
+  double settle_speed = static_cast<double>(WorldDef<3>{}.settle_speed);
+  double quiet_speed = 0.01;  ///< m/s: a drop slower than this for good has settled
   // Body-body data (4.); false (--no-body-contacts): a table of format 2.0 without it.
   bool body_contacts = true;
   int support_size = 17;    ///< S of the support map (6 S^2 values)

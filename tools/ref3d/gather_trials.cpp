@@ -78,12 +78,13 @@ DropTrial drop_trial(const Reference& ref, const GatherOptions& o, std::uint64_t
   s.spin = rng.direction() * rng.uniform(0, 4 * kPi);
   const double lift = L * rng.uniform(0.25, 3.0);
   s.position = Eigen::Vector3d(0, 0, -lowest_point(m.hull, s) + lift);
-  const DropResult r = ref.drop(s, o.still_speed, o.still_time, o.max_drop_time);
+  const DropResult r = ref.drop(s, o.still_speed, o.still_time, o.max_drop_time, {o.settle_speed, o.quiet_speed});
   DropTrial d;
   d.up = r.rest.orientation.conjugate() * Eigen::Vector3d::UnitZ();
   d.height = r.height;
   d.time = r.time;
   d.settled = r.settled;
+  d.settle_time = r.settle_time;
   return d;
 }
 

@@ -31,12 +31,14 @@ ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, doubl
 /// One h_coll flight: the centre height at first contact.
 double height_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index);
 
-/// One rest drop: where the body's up vector ended (body frame), at what height, after how long.
+/// One rest drop: where the body's up vector ended (body frame), at what height, after how long,
+/// and how long it took to settle once slow (DropResult::settle_time, s).
 struct DropTrial {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   double height = 0.0;
   double time = 0.0;
   bool settled = false;
+  double settle_time = 0.0;
 };
 /// Drop `index`: a random pose and velocity with gravity until the body is still.
 DropTrial drop_trial(const Reference& ref, const GatherOptions& o, std::uint64_t index);

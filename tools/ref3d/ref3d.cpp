@@ -59,6 +59,7 @@ struct GatherCommand {
   bool settings_check = false;
   bool no_body_contacts = false;
   bool no_landing = false;
+  bool settle = false;
   std::vector<double> check_speeds = {0.5, 1, 2, 4, 8};
   int check_trials = 200;
   // --size-for-scene (tools/ref3d/sizing.hpp)
@@ -207,6 +208,10 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.body_contacts = !c.no_body_contacts;
     // The landing data follows the body-body data in a table: a table of format 2.0 has neither.
     o.landing = !c.no_landing && o.body_contacts;
+    // The settling data follows the landing data: a table of format 2.2 or older has none. It is
+    // asked for: bodies then rock as long as the reference's, which a scene pays for in awake
+    // bodies (tools/fidelity/README.md, "Where the time to rest goes").
+    o.settle = c.settle && o.landing;
     if (!c.units.empty() && !units_scale(c.units, o.mesh_scale))
       throw std::runtime_error("--units '" + c.units + "': expected m, cm, mm, in or ft");
     o.mesh_units_given = !c.units.empty() || sub.get_option("--scale")->count() > 0;
@@ -277,6 +282,8 @@ void run(const GatherCommand& c, const CLI::App& sub)
       // The landing probabilities correct the draws of the gathering's own model and precision:
       // another model's draws stay otherwise, so its JSON leaves them out.
       other.landing = LandingFit{};
+      // The settling data stays: it comes from the rest drops, whatever model reduces the
+      // impacts (a JSON, unlike a header, may hold it without the landing data).
       write_file_atomic(file, json_text(other, command + " (JSON of --response-model " +
                                                    response_model_name(options.response_model) + ")"));
     }
@@ -407,6 +414,21 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   sub->add_option("--landing-hop", o.landing_hop, "Landing: rise over L below which an impact counts as a stay")
       ->capture_default_str();
   sub->add_option("--landing-time", o.landing_time, "Landing: s after which an impact not flown off counts as a stay")
+      ->capture_default_str();
+  sub->add_flag("--settle", c->settle,
+                "Add the settling data (a table of format 2.3; needs the landing data): per rest pose, quantiles "
+                "of the time a rest drop took from its last moment at --settle-speed to staying below "
+                "--quiet-speed (statsim/signature_settle.hpp)");
+  sub->add_option("--settle-quantiles", o.settle_quantiles,
+                  "Settling: quantiles of the settling time per rest pose (1 to " +
+                      std::to_string(max_settle_quantiles) + ")")
+      ->capture_default_str();
+  sub->add_option("--settle-speed", o.settle_speed,
+                  "Settling: m/s; the settling time starts at the last step this fast (centre, or farthest point by "
+                  "spin); the default is the runtime's WorldDef::settle_speed")
+      ->capture_default_str();
+  sub->add_option("--quiet-speed", o.quiet_speed,
+                  "Settling: m/s, below --settle-speed; the settling time ends when the body stays slower for good")
       ->capture_default_str();
   sub->add_flag("--no-body-contacts", c->no_body_contacts,
                 "Leave out the body-body data (a table of format 2.0, as written before it existed)");

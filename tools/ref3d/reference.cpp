@@ -3,6 +3,7 @@
 #include "bullet/bullet.hpp"
 #include "ref3d/bullet_state.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -238,7 +239,8 @@ ImpactResult Reference::impact(const RigidState& start, double max_time) const
   return r;
 }
 
-DropResult Reference::drop(const RigidState& start, double still_speed, double still_time, double max_time) const
+DropResult Reference::drop(const RigidState& start, double still_speed, double still_time, double max_time,
+                           const SettleSpeeds& speeds) const
 {
   auto w = impl_->make_world(settings_, ground_, start, settings_.gravity, settings_.rest_rolling_friction);
   DropResult r;
@@ -251,9 +253,18 @@ DropResult Reference::drop(const RigidState& start, double still_speed, double s
   // a resting GImpact body jitters by a few mm/s from step to step while going nowhere.
   RigidState anchor = start;
   int quiet = 0;
-  for (int step = 1; step <= max_steps; ++step) {
+  // The settling time's two ends, in steps: the last step at the settle speed or faster, and the
+  // last at the quiet speed or faster (0: none; the state at the start is not a step).
+  int last_fast = 0, last_moving = 0;
+  int step = 0;
+  while (step < max_steps) {
+    ++step;
     w->world.stepSimulation(dt, 0, dt);
     r.time = step * dt;
+    const double speed = std::max(to_eigen(w->body->getLinearVelocity()).norm(),
+                                  to_eigen(w->body->getAngularVelocity()).norm() * radius);
+    if (speed >= speeds.settle) last_fast = step;
+    if (speed >= speeds.quiet) last_moving = step;
     if (step % window != 0) continue;
     const RigidState s = state_of(*w->body);
     const double moved = (s.position - anchor.position).norm();
@@ -266,6 +277,10 @@ DropResult Reference::drop(const RigidState& start, double still_speed, double s
       break;
     }
   }
+  // Quiet from the step after the last moving one; a drop that never got there within its run
+  // (not settled, or moving at its last step) counts to the run's end, a lower bound.
+  const int quiet_from = r.settled ? std::min(last_moving + 1, step) : step;
+  r.settle_time = std::max(0, quiet_from - last_fast) * dt;
   r.rest = state_of(*w->body);
   r.height = r.rest.position.z() - lowest_point(model_.hull, r.rest);
   return r;

@@ -66,12 +66,26 @@ struct ImpactResult {
   double max_penetration = 0.0;  ///< m, deepest true-geometry penetration seen after a step
 };
 
+/// The two speeds that time a drop's settling (DropResult::settle_time), m/s. A body's speed at a
+/// step is the larger of its centre's and its farthest point's by spin (|w| times the bounding
+/// radius), instantaneous: the runtime starts settling a body below `settle`
+/// (statsim::WorldDef::settle_speed), and a body below `quiet` no longer moves visibly.
+struct SettleSpeeds {
+  double settle = 0.0;
+  double quiet = 0.0;  ///< below `settle`
+};
+
 /// What a rest drop produced.
 struct DropResult {
   RigidState rest;          ///< when it settled (or at the time limit)
   double height = 0.0;      ///< centre of mass above the plane on the true geometry, m
   double time = 0.0;        ///< s of simulation
   bool settled = false;
+  /// s from the last step at the settle speed or faster (0 when none was) to the step after the
+  /// last one at the quiet speed or faster, when the body stayed slower for good. A drop that did
+  /// not settle, or was still that fast at its last step, counts up to the end of its run: a
+  /// lower bound of its settling time.
+  double settle_time = 0.0;
 };
 
 /// Bullet objects for one shape (one per thread: nothing is shared between threads). Every
@@ -89,8 +103,10 @@ public:
 
   /// With gravity: from `start` until the body is still (its centre and its farthest point
   /// moved on average slower than `still_speed` over each of two consecutive windows of
-  /// `still_time` seconds), or `max_time`.
-  DropResult drop(const RigidState& start, double still_speed, double still_time, double max_time) const;
+  /// `still_time` seconds), or `max_time`; its settling time measured with `speeds`, which do
+  /// not change the run.
+  DropResult drop(const RigidState& start, double still_speed, double still_time, double max_time,
+                  const SettleSpeeds& speeds) const;
 
   /// A world of its own with gravity stepped by the caller, for measurements outside the
   /// gathering (`statsim fidelity --reference gather`): the same Bullet world as drop()'s (same

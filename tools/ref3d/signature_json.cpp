@@ -185,6 +185,16 @@ void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::
                 s.landing.cos_theta.size() * s.landing.spin_ratio.size() * s.landing.froude.size(),
                 "landing.probability", origin);
   }
+  // Settling data (table format 2.3): optional; its values are checked by add_shape.
+  if (j.contains("settle")) {
+    const json& t = field(j, "settle", origin);
+    const Scalar quantiles = number(t, "quantiles", origin, "settle.");
+    if (!(quantiles >= 1 && quantiles <= Scalar(max_settle_quantiles)) || quantiles != std::floor(quantiles))
+      fail(origin,
+           "field 'settle.quantiles' must be a whole number in [1, " + std::to_string(max_settle_quantiles) + "]");
+    s.settle.time = numbers(t, "time", origin, "settle.");
+    expect_size(s.settle.time, static_cast<std::size_t>(quantiles) * s.rest_heights.size(), "settle.time", origin);
+  }
   if (!j.contains("body_contacts")) return;
   s.mesh_frame = numbers(j, "mesh_frame", origin);
   expect_size(s.mesh_frame, 12, "mesh_frame", origin);
@@ -254,6 +264,7 @@ std::size_t signature_bytes(const SignatureView<3>& sig)
     bytes += f + sig.landing.probability.size * f;
     for (const AxisView& a : sig.landing.axes) bytes += a.size * f;
   }
+  bytes += sig.settle.time.size * f;  // the quantiles of every rest pose
   return bytes;
 }
 

@@ -13,7 +13,8 @@
 // SignatureQ16 header stores them. Tables of format 2.1 also give mesh_frame and body_contacts
 // {support_size, support, pair_mean, pair_stddev, faces, packing_mean, packing_stddev}; the
 // support map of an i16 table is quantised by statsim::quantize16 as the header stores it.
-// Tables of format 2.2 may give landing {hop, cos_theta, spin_ratio, froude, probability}.
+// Tables of format 2.2 may give landing {hop, cos_theta, spin_ratio, froude, probability}, and
+// of format 2.3 settle {quantiles, time} (`quantiles` values for each rest pose).
 #pragma once
 
 #include "statsim/signature.hpp"
@@ -70,6 +71,10 @@ struct BasicLoadedSignature3 {
     Scalar hop = 0;
     std::vector<Scalar> cos_theta, spin_ratio, froude, probability;
   } landing;
+  /// Settling data (statsim::SettleView); `time` empty when the JSON has none.
+  struct Settle {
+    std::vector<Scalar> time;
+  } settle;
 
   SignatureView<3> view() const { return signature_view<3>(*this); }
 };
