@@ -104,19 +104,13 @@ void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, cons
   } else if (ground_contact && b.rest_pose != no_rest_pose) {
     if (!(v.dot(n) < 0)) return;
     v = point_particle_velocity<D>(v, n, shape.material, def.restitution_threshold);
-    const Vec pose = shape.signature.rest.normal(b.rest_pose);
-    const auto offset = rest_turn(b.orientation, pose, n, Scalar(1));
+    const auto offset = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, Scalar(1));
     if (b.slow_time < 0) {
       // Its settling time runs (`SettleView`, a negative `slow_time`): it turns into its pose and
       // rocks about it at the amplitude at which its farthest point swings at the sleep speed.
       const Scalar omega = 1 / def.rest_turn_time;
       b.angular_velocity = settle_rock(offset, n, -b.slow_time, omega, def.sleep_speed / (omega * shape.bounding_radius),
                                        def.rest_turn_time);
-    } else if (shape.signature.settle.present() && Vec(b.orientation * pose).dot(n) >= def.rest_snap_cosine) {
-      // Its settling time is over and it is within the snap angle: it stops, as the reference's
-      // body does, instead of creeping the last degrees (`update_motion_states` snaps it into the
-      // pose).
-      b.angular_velocity = Space<D>::zero_spin();
     } else {
       b.angular_velocity = offset / def.rest_turn_time;
     }
