@@ -220,6 +220,20 @@ enum class ResponseLayout : std::uint8_t {
   with_speed,
 };
 
+/// What the spin components of a response table measure (the generator writes one of these;
+/// `statsim gather --response-spin`). |V-| is the speed the body struck with.
+enum class ResponseSpin : std::uint8_t {
+  /// W+ L / |V-|, in the contact frame: the paper's normalisation (3.3.2). The drawn spin does
+  /// not depend on how the body is turned, so its kinetic energy does: on a thin shape a spin
+  /// the reference made about the long axis, cheap there, may be drawn about a short one.
+  length,
+  /// K W+ / |V-|, in the contact frame, with K = R diag(sqrt(I_k / m)) R^T the body's radii of
+  /// gyration about its principal axes at its orientation R. Half the squared length of the
+  /// draw is the rotational kinetic energy over 1/2 m |V-|^2 whatever the orientation; the
+  /// runtime takes W+ = R diag(sqrt(m / I_k)) R^T (draw) |V-| with the body's own R. 3D only.
+  gyration,
+};
+
 /// Everything the runtime knows about a shape.
 template <int D>
 struct SignatureView {
@@ -232,6 +246,7 @@ struct SignatureView {
   Material material{};         ///< restitution and friction the reference used, and V_particle+ uses
   Scalar restitution_threshold = 0;  ///< m/s, of V_particle+ (as the world's)
   ResponseLayout layout = ResponseLayout::scaled;
+  ResponseSpin spin = ResponseSpin::length;  ///< of the response table's w components (format 2.4)
   HeightTableView height;
   ResponseTableView response;  ///< components: 2D w, dv_x, dv_y; 3D w_xyz, dv_xyz
   RestPosesView<D> rest;
@@ -286,6 +301,11 @@ template <class T>
 struct has_settle_data<T, std::void_t<decltype(std::declval<const T&>().settle.time)>> : std::true_type {};
 
 template <class T, class = void>
+struct has_response_spin : std::false_type {};
+template <class T>
+struct has_response_spin<T, std::void_t<decltype(std::declval<const T&>().spin)>> : std::true_type {};
+
+template <class T, class = void>
 struct has_mesh_frame : std::false_type {};
 template <class T>
 struct has_mesh_frame<T, std::void_t<decltype(std::declval<const T&>().mesh_frame)>> : std::true_type {};
@@ -314,6 +334,7 @@ constexpr SignatureView<D> signature_view(const S& s)
   v.material = s.material;
   v.restitution_threshold = s.restitution_threshold;
   v.layout = s.layout;
+  if constexpr (detail::has_response_spin<S>::value) v.spin = s.spin;
   v.height.spin_ratio = AxisView(s.height_axis);
   v.height.mean = detail::values_view(s.height_mean);
   v.height.stddev = detail::values_view(s.height_stddev);
@@ -386,10 +407,10 @@ constexpr std::array<Scalar, D*(D + 1)> identity_mesh_frame()
 ///   NH: height samples; A0..A3: response axis sizes (unused axes 1); NR: rest poses;
 ///   `Contact`: `ContactData`/`ContactDataQ16`, or `NoContactData`;
 ///   `Landing`: `LandingData`, or `NoLandingData`; `Settle`: `SettleData`, or `NoSettleData`.
-/// `mesh_frame` and `contact` are new in format 2.1, `landing` in 2.2 and `settle` in 2.3; all
-/// have defaults, so
-/// an older table (which initialises everything before them) still compiles and loads, without
-/// that data.
+/// `mesh_frame` and `contact` are new in format 2.1, `landing` in 2.2, `settle` in 2.3 and
+/// `spin` in 2.4; all have defaults, so an older table (which initialises everything before
+/// them) still compiles and loads, without that data. `spin` belongs with `layout` and `model`
+/// but comes last for that reason.
 template <int D, std::uint32_t NH, std::uint32_t A0, std::uint32_t A1, std::uint32_t A2, std::uint32_t A3,
           std::uint32_t NR, class Means, class Spreads, class Contact = NoContactData, class Landing = NoLandingData,
           class Settle = NoSettleData>
@@ -424,6 +445,7 @@ struct BasicSignature {
   Contact contact = {};
   Landing landing = {};
   Settle settle = {};
+  ResponseSpin spin = ResponseSpin::length;  ///< see `SignatureView::spin`
 
   constexpr SignatureView<D> view() const { return signature_view<D>(*this); }
 };
@@ -501,7 +523,7 @@ constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, Quantized16<NM>, Quantized16
       s.restitution_threshold,      s.layout,          s.model,        s.axis_count,   s.height_axis,
       s.height_mean, s.height_stddev, s.axis0,         s.axis1,        s.axis2,        s.axis3,
       {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies,
-      s.mesh_frame,  s.contact,      s.landing,      s.settle};
+      s.mesh_frame,  s.contact,      s.landing,      s.settle,          s.spin};
   quantize16(s.response_mean.data(), s.response_mean.size(), q.response_mean.scale, q.response_mean.offset,
              q.response_mean.q.data());
   quantize16(s.response_spread.data(), s.response_spread.size(), q.response_spread.scale,
@@ -533,7 +555,7 @@ constexpr BasicSignature<D, NH, A0, A1, A2, A3, NR, std::array<Scalar, NM>, std:
       s.restitution_threshold,      s.layout,          s.model,        s.axis_count,   s.height_axis,
       s.height_mean, s.height_stddev, s.axis0,         s.axis1,        s.axis2,        s.axis3,
       {},            {},            s.rest_normals,    s.rest_heights, s.rest_frequencies,
-      s.mesh_frame,  s.contact,      s.landing,      s.settle};
+      s.mesh_frame,  s.contact,      s.landing,      s.settle,          s.spin};
   for (std::size_t i = 0; i < NM; ++i)
     f.response_mean[i] = s.response_mean.offset + s.response_mean.scale * Scalar(s.response_mean.q[i]);
   for (std::size_t i = 0; i < NS; ++i)

@@ -226,8 +226,9 @@ inline void sample_response(const ResponseTableView& table, const Scalar* x, Pcg
 /// The statistical response of paper 3.3.2, steps 2 to 8, for one body against a collision
 /// plane with unit normal `n` (pointing towards the body). `v` is the body's velocity relative to
 /// the plane (to the other body, for body-body contacts), `w` its spin; both are replaced.
-/// `orientation` (body to world) is needed only for the energy guard, which scales the sampled
-/// response down when it would leave more kinetic energy than the body brought to the contact.
+/// `orientation` (body to world) is needed for the energy guard, which scales the sampled
+/// response down when it would leave more kinetic energy than the body brought to the contact,
+/// and for a table whose spin is measured by `ResponseSpin::gyration`.
 /// The normal part of the new velocity is kept non-negative: a sphere that still approached the
 /// plane would collide again at once.
 /// `gravity` (m/s^2) is the part of gravity that presses the body onto the plane, for a contact
@@ -276,7 +277,16 @@ ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename
     sample_response(sig.response, x, rng, sample);
     Vec offset;
     if constexpr (D == 3) {
-      w_new = frame.basis * Vector3(sample[0], sample[1], sample[2]) * (speed / sig.length);
+      const Vector3 drawn = frame.basis * Vector3(sample[0], sample[1], sample[2]);
+      if (sig.spin == ResponseSpin::gyration) {
+        // W+ = R diag(sqrt(m / I_k)) R^T (draw) |V-|: the draw's rotational energy, 1/2 |draw|^2
+        // |V-|^2 per unit mass, whichever way the body is turned.
+        Vector3 body = orientation.conjugate() * drawn;
+        for (int k = 0; k < 3; ++k) body[k] /= std::sqrt(sig.unit_inertia[std::size_t(k)]);
+        w_new = orientation * body * speed;
+      } else {
+        w_new = drawn * (speed / sig.length);
+      }
       offset = frame.basis * Vector3(sample[3], sample[4], sample[5]) * speed;
     } else {
       w_new = frame.mirror * sample[0] * (speed / sig.length);

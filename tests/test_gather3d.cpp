@@ -6,6 +6,7 @@
 #include "ref3d/model.hpp"
 #include "ref3d/ref3d.hpp"
 #include "ref3d/reference.hpp"
+#include "ref3d/sampling.hpp"
 #include "ref3d/signature_json.hpp"
 
 #include "statsim/signature.hpp"
@@ -69,6 +70,45 @@ int gather_cli(std::vector<std::string> args, std::string* err_text = nullptr)
   const int rc = run_gather_command(args, out, err);
   if (err_text) *err_text = err.str();
   return rc;
+}
+
+// The tiny configuration with `extra` must be refused before any trial with `message`, and
+// write nothing.
+void check_refused(const TempDir& dir, const std::vector<std::string>& extra, const std::string& message)
+{
+  std::vector<std::string> args = tiny_args();
+  args.insert(args.end(), extra.begin(), extra.end());
+  args.insert(args.end(), {"--out", dir.file("x.hpp")});
+  std::string err;
+  CHECK(gather_cli(args, &err) != 0);
+  CHECK(err.find(message) != std::string::npos);
+  CHECK_FALSE(fs::exists(dir.file("x.hpp")));
+}
+
+// Writes `source` into `dir` as add_shape.cpp, compiles it as a user of the runtime would, and
+// runs it: it must exit with 0.
+void check_program_runs(const TempDir& dir, const std::string& source)
+{
+  const std::string program = dir.write("add_shape.cpp", source);
+  const std::string exe = dir.file("add_shape");
+  const std::string compile = std::string(STATSIM_TEST_CXX) + " -std=c++17 -O0 -Wall -Wextra -Wmissing-braces -Werror -I" +
+                              STATSIM_TEST_SOURCE_DIR + " -isystem " + STATSIM_TEST_EIGEN_INCLUDE + " " + program +
+                              " -o " + exe;
+  REQUIRE(std::system(compile.c_str()) == 0);
+  CHECK(std::system(exe.c_str()) == 0);
+}
+
+// A program that includes `header` (written in `dir`) and exits with 0 when `condition` (C++
+// over `v`, the view of table `table`) holds and add_shape accepts `v`, compiled and run.
+void check_compiles_and_adds(const TempDir& dir, const std::string& header, const std::string& table,
+                             const std::string& condition)
+{
+  check_program_runs(dir, "#include \"" + header + "\"\n"
+                          "#include \"statsim/world3.hpp\"\n#include <memory>\n"
+                          "int main()\n{\n"
+                          "  auto w = std::make_unique<statsim::World3<4>>(statsim::WorldDef3{});\n"
+                          "  const statsim::SignatureView<3> v = statsim::tables::" + table + ".view();\n"
+                          "  return " + condition + " && w->add_shape(v).ok() ? 0 : 1;\n}\n");
 }
 
 void append(std::vector<double>& v, const nlohmann::json& a)
@@ -581,20 +621,14 @@ TEST_CASE("gather3d: a header with body-body data compiles, and add_shape accept
     CHECK(text.find("#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 1\n#error ") !=
           std::string::npos);
   }
-  const std::string program = dir.write("add_shape.cpp", "#include \"t_f32.hpp\"\n#include \"t_i16.hpp\"\n"
-                                                         "#include \"statsim/world3.hpp\"\n#include <memory>\n"
-                                                         "int main()\n{\n"
-                                                         "  auto w = std::make_unique<statsim::World3<4>>(statsim::WorldDef3{});\n"
-                                                         "  int bad = 0;\n"
-                                                         "  for (const statsim::SignatureView<3>& v : {statsim::tables::t_f32.view(), statsim::tables::t_i16.view()})\n"
-                                                         "    bad += v.contact.present() && w->add_shape(v).ok() ? 0 : 1;\n"
-                                                         "  return bad;\n}\n");
-  const std::string exe = dir.file("add_shape");
-  const std::string compile = std::string(STATSIM_TEST_CXX) + " -std=c++17 -O0 -Wall -Wextra -Wmissing-braces -Werror -I" +
-                              STATSIM_TEST_SOURCE_DIR + " -isystem " + STATSIM_TEST_EIGEN_INCLUDE + " " + program +
-                              " -o " + exe;
-  REQUIRE(std::system(compile.c_str()) == 0);
-  CHECK(std::system(exe.c_str()) == 0);
+  check_program_runs(dir, "#include \"t_f32.hpp\"\n#include \"t_i16.hpp\"\n"
+                          "#include \"statsim/world3.hpp\"\n#include <memory>\n"
+                          "int main()\n{\n"
+                          "  auto w = std::make_unique<statsim::World3<4>>(statsim::WorldDef3{});\n"
+                          "  int bad = 0;\n"
+                          "  for (const statsim::SignatureView<3>& v : {statsim::tables::t_f32.view(), statsim::tables::t_i16.view()})\n"
+                          "    bad += v.contact.present() && w->add_shape(v).ok() ? 0 : 1;\n"
+                          "  return bad;\n}\n");
 }
 
 TEST_CASE("gather3d: a table outside the repository is the same bytes wherever its mesh and output are")
@@ -756,18 +790,7 @@ TEST_CASE("gather3d: a table of format 2.2 with landing data whose header compil
   REQUIRE(gather_cli(plain) == 0);
   CHECK(read_file(dir.file("t_plain.hpp")).find("LandingData") == std::string::npos);
 
-  const std::string program = dir.write("add_shape.cpp", "#include \"t_landing.hpp\"\n"
-                                                         "#include \"statsim/world3.hpp\"\n#include <memory>\n"
-                                                         "int main()\n{\n"
-                                                         "  auto w = std::make_unique<statsim::World3<4>>(statsim::WorldDef3{});\n"
-                                                         "  const statsim::SignatureView<3> v = statsim::tables::t_landing.view();\n"
-                                                         "  return v.landing.present() && v.landing.cells() == 8 && w->add_shape(v).ok() ? 0 : 1;\n}\n");
-  const std::string exe = dir.file("add_shape");
-  const std::string compile = std::string(STATSIM_TEST_CXX) + " -std=c++17 -O0 -Wall -Wextra -Wmissing-braces -Werror -I" +
-                              STATSIM_TEST_SOURCE_DIR + " -isystem " + STATSIM_TEST_EIGEN_INCLUDE + " " + program +
-                              " -o " + exe;
-  REQUIRE(std::system(compile.c_str()) == 0);
-  CHECK(std::system(exe.c_str()) == 0);
+  check_compiles_and_adds(dir, "t_landing.hpp", "t_landing", "v.landing.present() && v.landing.cells() == 8");
 }
 
 TEST_CASE("gather3d: settling-time quantiles stand each order statistic at the middle of its share")
@@ -883,27 +906,94 @@ TEST_CASE("gather3d: a table of format 2.3 with settling data whose header compi
   CHECK_FALSE(nlohmann::json::parse(read_file(dir.file("p.json"))).contains("settle"));
 
   // Speeds the measurement cannot use are refused before any trial, nothing written.
-  std::string err;
-  std::vector<std::string> loud = tiny_args();
-  loud.insert(loud.end(), {"--settle", "--quiet-speed", "0.5", "--out", dir.file("x.hpp")});
-  CHECK(gather_cli(loud, &err) != 0);
-  CHECK(err.find("--quiet-speed must be positive and below --settle-speed (0.5 m/s)") != std::string::npos);
-  std::vector<std::string> many = tiny_args();
-  many.insert(many.end(), {"--settle", "--settle-quantiles", "65", "--out", dir.file("x.hpp")});
-  CHECK(gather_cli(many, &err) != 0);
-  CHECK(err.find("--settle-quantiles must be in [1, 64]") != std::string::npos);
-  CHECK_FALSE(fs::exists(dir.file("x.hpp")));
+  check_refused(dir, {"--settle", "--quiet-speed", "0.5"}, "--quiet-speed must be positive and below --settle-speed (0.5 m/s)");
+  check_refused(dir, {"--settle", "--settle-quantiles", "65"}, "--settle-quantiles must be in [1, 64]");
 
-  const std::string program = dir.write("add_shape.cpp", "#include \"t_settle.hpp\"\n"
-                                                         "#include \"statsim/world3.hpp\"\n#include <memory>\n"
-                                                         "int main()\n{\n"
-                                                         "  auto w = std::make_unique<statsim::World3<4>>(statsim::WorldDef3{});\n"
-                                                         "  const statsim::SignatureView<3> v = statsim::tables::t_settle.view();\n"
-                                                         "  return v.settle.present() && v.settle.quantiles == 5 && w->add_shape(v).ok() ? 0 : 1;\n}\n");
-  const std::string exe = dir.file("add_shape");
-  const std::string compile = std::string(STATSIM_TEST_CXX) + " -std=c++17 -O0 -Wall -Wextra -Wmissing-braces -Werror -I" +
-                              STATSIM_TEST_SOURCE_DIR + " -isystem " + STATSIM_TEST_EIGEN_INCLUDE + " " + program +
-                              " -o " + exe;
-  REQUIRE(std::system(compile.c_str()) == 0);
-  CHECK(std::system(exe.c_str()) == 0);
+  check_compiles_and_adds(dir, "t_settle.hpp", "t_settle", "v.settle.present() && v.settle.quantiles == 5");
+}
+
+TEST_CASE("gather3d: a response trial's spin by gyration carries its rotational energy")
+{
+  // A 1 x 2 x 4 box: three different moments, so the two measures differ with the orientation.
+  GatherOptions o;
+  o.box_size = {0.05, 0.1, 0.2};
+  const ShapeModel m = build_model(o);
+  const Reference ref(m, o.reference);
+  const double L = m.bounding_radius, speed = 2.0;
+  for (std::uint64_t i = 0; i < 6; ++i) {
+    CAPTURE(i);
+    const ResponseTrial t = response_trial(ref, o, 0.7, 0.5, speed, 2.0, kResponseStream, i);
+    const Eigen::Vector3d w = Eigen::Vector3d(t.value[0], t.value[1], t.value[2]) * (speed / L);
+    const Eigen::Vector3d b = t.departure.orientation.conjugate() * w;
+    const double energy = 0.5 * (m.unit_inertia.x() * b.x() * b.x() + m.unit_inertia.y() * b.y() * b.y() +
+                                 m.unit_inertia.z() * b.z() * b.z());
+    const Eigen::Vector3d k(t.gyration[0], t.gyration[1], t.gyration[2]);
+    CHECK(0.5 * k.squaredNorm() * speed * speed == doctest::Approx(energy).epsilon(1e-9));
+    for (int c = 3; c < 6; ++c) CHECK(t.gyration[c] == t.value[c]);
+    CHECK((t.contact.velocity - speed * Eigen::Vector3d(std::sqrt(1 - 0.49), 0, -0.7)).norm() < 1e-9);
+  }
+}
+
+TEST_CASE("gather3d: a table of format 2.4 with the spin by gyration whose header compiles and whose JSON loads with it")
+{
+  TempDir dir("gather3d_spin");
+  // The tiny configuration on a 1 x 2 x 4 box instead of the cube (--box-size excludes --shape).
+  const auto thin_box = []() {
+    std::vector<std::string> a = tiny_args();
+    a.erase(a.begin(), a.begin() + 2);
+    a.insert(a.end(), {"--box-size", "0.05,0.1,0.2"});
+    return a;
+  };
+  std::vector<std::string> args = thin_box();
+  args.insert(args.end(), { "--landing-trials", "2", "--landing-froude", "0,16",
+                           "--response-spin", "gyration", "--name", "t_spin", "--out", dir.file("t_spin.hpp"), "--json",
+                           dir.file("t.json")});
+  REQUIRE(gather_cli(args) == 0);
+  const std::string text = read_file(dir.file("t_spin.hpp"));
+  const nlohmann::json j = nlohmann::json::parse(read_file(dir.file("t.json")));
+  CHECK(text.find("#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 4\n#error ") !=
+        std::string::npos);
+  CHECK(text.find("needs table format 2.4 (spin by gyration): update statsim, or regenerate the table with "
+                  "--response-spin length") != std::string::npos);
+  CHECK(text.find("// Response spin: by gyration, K W+ / |V-| (statsim::ResponseSpin::gyration); test: ") != std::string::npos);
+  CHECK(text.find("    {},  // no settling data\n    statsim::ResponseSpin::gyration,") != std::string::npos);
+  CHECK(j["response"]["spin"] == "gyration");
+  // Given, the test is still run and reported, for the header and the JSON.
+  REQUIRE(j["response"].contains("spin_test"));
+  CHECK(text.find("; test: KS of |V+| and |W+| against the trials by gyration ") != std::string::npos);
+  const LoadedSignature3 s = load_signature_json(dir.file("t.json"));
+  CHECK(s.view().spin == statsim::ResponseSpin::gyration);
+  // A JSON naming another measure is refused, by name.
+  nlohmann::json bad = j;
+  bad["response"]["spin"] = "momentum";
+  CHECK_THROWS_WITH_AS(parse_signature_json(bad.dump(), "x.json"),
+                       doctest::Contains("x.json: field 'response.spin' is neither"), std::runtime_error);
+
+  // The default chooses, and reports its test: gyration only below length's distance by the margin.
+  std::vector<std::string> chosen = thin_box();
+  chosen.insert(chosen.end(), {"--landing-trials", "2", "--landing-froude", "0,16",
+                               "--name", "t_auto", "--out", dir.file("t_auto.hpp"), "--json", dir.file("a.json")});
+  REQUIRE(gather_cli(chosen) == 0);
+  const nlohmann::json a = nlohmann::json::parse(read_file(dir.file("a.json")));
+  REQUIRE(a["response"].contains("spin_test"));
+  const nlohmann::json& test = a["response"]["spin_test"];
+  const double n = test["draws"].get<double>();
+  CHECK(n == a["response"]["trials"].get<double>());
+  CHECK(test["critical"].get<double>() == doctest::Approx(1.358 * std::sqrt(2.0 / n)));
+  const bool gyration = test["ks_gyration"].get<double>() < test["ks_length"].get<double>() - test["critical"].get<double>();
+  CHECK(a["response"].contains("spin") == gyration);
+  // --response-spin length neither tests nor names the measure: the table of format 2.2.
+  std::vector<std::string> plain = tiny_args();
+  plain.insert(plain.end(), {"--landing-trials", "2", "--landing-froude", "0,16", "--response-spin", "length",
+                             "--name", "t_plain", "--out", dir.file("t_plain.hpp"), "--json", dir.file("p.json")});
+  REQUIRE(gather_cli(plain) == 0);
+  const nlohmann::json p = nlohmann::json::parse(read_file(dir.file("p.json")));
+  CHECK_FALSE(p["response"].contains("spin"));
+  CHECK_FALSE(p["response"].contains("spin_test"));
+  CHECK(read_file(dir.file("t_plain.hpp")).find("STATSIM_TABLE_FORMAT_MINOR < 2\n#error ") != std::string::npos);
+
+  // Gyration without the landing data it follows in a table is refused before any work.
+  check_refused(dir, {"--response-spin", "gyration", "--no-landing"}, "--response-spin gyration needs the landing data");
+
+  check_compiles_and_adds(dir, "t_spin.hpp", "t_spin", "v.spin == statsim::ResponseSpin::gyration");
 }

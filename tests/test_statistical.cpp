@@ -3,9 +3,13 @@
 #include "scenes/synthetic_signatures.hpp"
 
 #include "statsim/statistical.hpp"
+#include "statsim/world2.hpp"
+#include "statsim/world3.hpp"
 #include "tables/bunny.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 using namespace statsim;
@@ -144,6 +148,88 @@ TEST_CASE("3D frame transforms: sampled responses rotated back match the table c
       CHECK(std::fabs(sdev - sd[k]) < 5 * sd[k] / std::sqrt(2.0 * samples));
     }
   }
+}
+
+TEST_CASE("spin by gyration: a draw's rotational energy does not depend on how the body is turned")
+{
+  // A thin body (moments 0.002, 0.1, 0.1 m^2) and a table without spread: each draw is the
+  // cell's mean, so the spin the runtime makes of it can be checked exactly.
+  Sig3 sig = make_sig3();
+  sig.unit_inertia = {0.002f, 0.1f, 0.1f};
+  for (Scalar& x : sig.response_spread) x = 0;
+  Sig3 by_length = sig;
+  sig.spin = ResponseSpin::gyration;
+  const SignatureView<3> view = sig.view(), length_view = by_length.view();
+  REQUIRE(view.spin == ResponseSpin::gyration);
+  REQUIRE(length_view.spin == ResponseSpin::length);
+  const Vector3 n(0, 0, 1), v0(1, 0, -std::sqrt(3.0f)), w0(0, 4, 0);  // cos theta 0.866, |V-| = 2 m/s
+  const Scalar speed = v0.norm();
+  Scalar coords[4];
+  const ContactFrame<3> frame = contact_frame(n, v0, w0);
+  response_coordinates<3>(view, frame, n, v0, w0, coords);
+  Scalar mean[6], sd[6];
+  view.response.lookup(coords, mean, sd);
+  const Vector3 drawn = frame.basis * Vector3(mean[0], mean[1], mean[2]);
+  const Scalar expected = Scalar(0.5) * drawn.squaredNorm() * speed * speed;
+  const auto rotational = [&](const Quaternion& q, const Vector3& w) {
+    const Vector3 b = q.conjugate() * w;
+    return Scalar(0.5) * (sig.unit_inertia[0] * b.x() * b.x() + sig.unit_inertia[1] * b.y() * b.y() +
+                          sig.unit_inertia[2] * b.z() * b.z());
+  };
+  Pcg32 g(9, 1);
+  Scalar low = 1e30f, high = 0;
+  for (int k = 0; k < 32; ++k) {
+    const Quaternion q = Quaternion(g.uniform(-1, 1), g.uniform(-1, 1), g.uniform(-1, 1), g.uniform(-1, 1)).normalized();
+    CAPTURE(k);
+    Vector3 v = v0, w = w0;
+    Pcg32 r(1, 1);
+    const ResponseOutcome o = statistical_response<3>(view, q, n, v, w, r);
+    REQUIRE(o.applied);
+    REQUIRE_FALSE(o.energy_clamped);
+    CHECK(rotational(q, w) == doctest::Approx(expected).epsilon(1e-5));
+    // The spin itself: R diag(1 / sqrt(I_k / m)) R^T (draw) |V-|.
+    Vector3 b = q.conjugate() * drawn;
+    for (int i = 0; i < 3; ++i) b[i] /= std::sqrt(sig.unit_inertia[std::size_t(i)]);
+    CHECK((w - q * b * speed).norm() < 1e-4f * w.norm());
+    // The same draw by length keeps the spin whatever the orientation, so its energy changes.
+    Vector3 vl = v0, wl = w0;
+    Pcg32 rl(1, 1);
+    REQUIRE(statistical_response<3>(length_view, q, n, vl, wl, rl).applied);
+    CHECK((wl - drawn * (speed / view.length)).norm() < 1e-5f * wl.norm());
+    low = std::min(low, rotational(q, wl));
+    high = std::max(high, rotational(q, wl));
+  }
+  CHECK(high > 3 * low);
+}
+
+TEST_CASE("spin by gyration: add_shape refuses it in 2D, without every moment, or as an unknown value")
+{
+  const auto refused = [](auto& world, const auto& v) {
+    const std::uint32_t shapes = world.shape_count();
+    CHECK(world.add_shape(v).status == Status::invalid_shape);
+    CHECK(world.shape_count() == shapes);
+  };
+  auto w3 = std::make_unique<World3<4>>();
+  Sig3 sig = make_sig3();
+  sig.spin = ResponseSpin::gyration;
+  SignatureView<3> v = sig.view();
+  v.unit_inertia[1] = 0;  // not recorded
+  refused(*w3, v);
+  v.unit_inertia[1] = Scalar(1e-9) * v.length * v.length;  // a radius of gyration that vanishes
+  refused(*w3, v);
+  v = sig.view();
+  v.spin = static_cast<ResponseSpin>(2);
+  refused(*w3, v);
+  CHECK(w3->add_shape(sig.view()).ok());
+  // The measure is part of the table: a shape by gyration hashes apart from the same by length.
+  Sig3 by_length = make_sig3();
+  CHECK(detail::signature_hash(by_length.view()) != detail::signature_hash(sig.view()));
+
+  auto w2 = std::make_unique<World2<4>>();
+  SignatureView<2> v2 = testing::square2d_synthetic.view();
+  v2.spin = ResponseSpin::gyration;
+  refused(*w2, v2);
+  CHECK(w2->add_shape(testing::square2d_synthetic.view()).ok());
 }
 
 TEST_CASE("2D frame transforms: mirrored contacts flip the spin and the tangent")

@@ -71,8 +71,8 @@ std::uint64_t signature_hash(const SignatureView<D>& sig)
     h.add(sig.rest.heights[i]);
     h.add(sig.rest.frequencies[i]);
   }
-  // Body-body data, landing data and settling data, each when the table has it (a table
-  // without them hashes as before).
+  // Body-body data, landing data, settling data and the spin measure, each when the table has
+  // it (a table without them hashes as before).
   const ContactView<D>& c = sig.contact;
   if (c.present()) {
     h.add_all(c.support_size, c.face_count);
@@ -95,6 +95,7 @@ std::uint64_t signature_hash(const SignatureView<D>& sig)
     for (std::uint32_t i = 0; i < t.time.size; ++i) h.add(t.time.values[i]);
     if (sig.scale != 1) h.add(sig.scale);  // settling times scale with the shape (`update_rest_pose`)
   }
+  if (sig.spin != ResponseSpin::length) h.add(std::uint8_t(sig.spin));  // a `length` table hashes as before
   return h.value;
 }
 

@@ -143,7 +143,8 @@ std::string table_prologue(const std::string& name, int minor, const TableTarget
     // define the types the table names, so the compiler would stop at them first.
     const std::string full = version + "." + std::to_string(minor);
     const std::string what =
-        minor >= 3   ? " (settling data): update statsim, or regenerate the table without --settle"
+        minor >= 4   ? " (spin by gyration): update statsim, or regenerate the table with --response-spin length"
+        : minor == 3 ? " (settling data): update statsim, or regenerate the table without --settle"
         : minor == 2 ? " (landing data): update statsim, or regenerate the table with --no-landing"
                      : " (body-body data): update statsim, or regenerate the table with --no-body-contacts";
     s += "#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < " + std::to_string(minor) +

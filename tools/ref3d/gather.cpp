@@ -1,6 +1,6 @@
 // The gathering of `statsim gather` (see gather.hpp): runs the stages in order, each on the
 // options' worker threads: h_coll flights, response trials and their fit, rest drops and their
-// poses, the body-body data, the landing data and the settling data.
+// poses, the body-body data, the spin measure, the landing data and the settling data.
 #include "ref3d/gather.hpp"
 
 #include "common/parallel.hpp"
@@ -62,7 +62,8 @@ GatherResult gather(const GatherOptions& options)
     r.ground = probe.ground() == Ground::box ? "box" : "plane";
   }
 
-  // 2. Responses.
+  // 2. Responses (the trials are kept for the spin measure).
+  std::vector<ResponseTrial> all;
   {
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<double> fixed_speed{o.speed};
@@ -72,7 +73,7 @@ GatherResult gather(const GatherOptions& options)
     r.axes.push_back(o.spin_ratios);
     const std::size_t nt = o.cos_theta.size(), np = o.cos_phi.size(), nv = speeds.size(), ns = o.spin_ratios.size();
     const std::size_t cells = nt * np * nv * ns, trials = static_cast<std::size_t>(o.trials);
-    std::vector<ResponseTrial> all(cells * trials);
+    all.resize(cells * trials);
     Progress progress("responses", cells * trials, o.progress);
     parallel_for(
         cells,
@@ -114,14 +115,17 @@ GatherResult gather(const GatherOptions& options)
   // 4. Body-body data.
   if (o.body_contacts) gather_body_contacts(r);
 
-  // 5. Landing data, against the tables as the runtime reads them (the JSON's, at the stored
+  // 5. The spin measure (gather_spin.hpp), before the landing data, whose draws read it.
+  choose_spin(r, all);
+
+  // 6. Landing data, against the tables as the runtime reads them (the JSON's, at the stored
   // precision; it has no landing data yet).
   if (o.landing && o.body_contacts) {  // a table holds landing data after its body-body data
     const LoadedSignature3 tables = parse_signature_json(json_text(r, "landing stage"), "the gathered tables");
     r.landing = gather_landing(o, pool, tables.view());
   }
 
-  // 6. Settling data, from the rest drops of 3. (a table holds it after its landing data).
+  // 7. Settling data, from the rest drops of 3. (a table holds it after its landing data).
   if (o.settle && o.landing && o.body_contacts) r.settle = fit_settle(drops, r.rest, o);
   return r;
 }

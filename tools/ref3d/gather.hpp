@@ -41,6 +41,7 @@
 #include "ref3d/gather_landing.hpp"
 #include "ref3d/gather_options.hpp"
 #include "ref3d/gather_settle.hpp"
+#include "ref3d/gather_spin.hpp"
 #include "ref3d/gather_trials.hpp"
 #include "ref3d/response_fit.hpp"
 #include "ref3d/rest_poses.hpp"
@@ -67,6 +68,8 @@ struct GatherResult : ResponseFit, RestPoseFit {
   BodyContactData contact;  ///< when options.body_contacts
   LandingFit landing;       ///< when options.landing
   SettleFit settle;         ///< when options.settle (and the landing data it follows)
+  ResponseSpin spin = ResponseSpin::length;  ///< what the response statistics' spin measures
+  SpinTest spin_test;       ///< how `spin` was chosen (gather_spin.hpp)
   // timings, s
   double height_seconds = 0.0, response_seconds = 0.0, rest_seconds = 0.0;
 };

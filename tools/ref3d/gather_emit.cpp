@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 namespace statsim::tools::ref3d {
 
@@ -191,7 +192,21 @@ std::string header_text(const GatherResult& r, const std::string& command)
     for (std::size_t i = 0; i < t.drops.size(); ++i) h << " " << t.drops[i] << " " << fmt("%.3f", t.mean[i]) << " s;";
     h << "\n";
   }
-  h << table_prologue(o.name, settle ? 3 : landing ? 2 : contact ? 1 : 0, o.target);
+  // The spin measure (format 2.4) comes last in the initialiser, after the landing data it needs
+  // (gather_spin.hpp never takes gyration without it) and the settling data or its `{}`.
+  const bool gyration = r.spin == ResponseSpin::gyration;
+  if (gyration && !landing) throw std::runtime_error("a table with the spin by gyration needs the landing data");
+  if (gyration) {
+    const SpinTest& t = r.spin_test;
+    h << "// Response spin: by gyration, K W+ / |V-| (statsim::ResponseSpin::gyration)";
+    if (t.run)
+      h << "; test: KS of |V+| and |W+| against the trials by gyration " << fmt("%.4f", t.ks_gyration)
+        << ", by length " << fmt("%.4f", t.ks_length) << " (auto takes gyration below length - "
+        << fmt("%.4f", t.critical) << "; " << t.trials << " draws); energy guard " << fmt("%.4f", t.clamp_gyration)
+        << ", by length " << fmt("%.4f", t.clamp_length);
+    h << "\n";
+  }
+  h << table_prologue(o.name, gyration ? 4 : settle ? 3 : landing ? 2 : contact ? 1 : 0, o.target);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
                     a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
   h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
@@ -234,7 +249,8 @@ std::string header_text(const GatherResult& r, const std::string& command)
   const char* spread_text[] = {"std per component",
                                "Cholesky factor of the covariance, lower triangle row by row",
                                "stored outcomes minus their mean, one after another"};
-  h << table_comment("response mean per cell: w_x, w_y, w_z (W+ L/|V-|), dv_x, dv_y, dv_z ((V+ - V_particle+)/|V-|)");
+  h << table_comment(std::string("response mean per cell: w_x, w_y, w_z (") + (gyration ? "K W+ / |V-|" : "W+ L/|V-|") +
+                     "), dv_x, dv_y, dv_z ((V+ - V_particle+)/|V-|)");
   h << table_comment(std::string("then the spread per cell: ") + spread_text[static_cast<int>(o.response_model)]);
   if (o.i16) {
     // statsim::Quantized16: {scale, offset, {{values}}}.
@@ -273,6 +289,10 @@ std::string header_text(const GatherResult& r, const std::string& command)
     h << "    {\n";
     h << "      " << hex_float_array(t.time, ArrayStyle{static_cast<std::size_t>(t.quantiles), 8, true, 6}) << ",\n";
     h << "    },\n";
+  }
+  if (gyration) {
+    if (!settle) h << table_entry("{}", "no settling data");
+    h << table_entry("statsim::ResponseSpin::gyration", "spin components: K W+ / |V-|");
   }
   h << table_epilogue(o.target);
   return h.str();
@@ -349,6 +369,14 @@ std::string json_text(const GatherResult& r, const std::string& command)
                    {"spread_scale", static_cast<double>(qs.scale)},
                    {"spread_offset", static_cast<double>(qs.offset)},
                    {"worst_error", std::max(qm.worst_error, qs.worst_error)}};
+  }
+  // Only a table by gyration names its spin measure: a JSON without "spin" is by length.
+  if (r.spin == ResponseSpin::gyration) resp["spin"] = "gyration";
+  if (r.spin_test.run) {
+    const SpinTest& t = r.spin_test;
+    resp["spin_test"] = {{"draws", t.trials},          {"ks_length", t.ks_length},
+                         {"ks_gyration", t.ks_gyration}, {"critical", t.critical},
+                         {"clamp_length", t.clamp_length}, {"clamp_gyration", t.clamp_gyration}};
   }
   j["response"] = resp;
   json rest = json::array();
@@ -455,6 +483,16 @@ std::string summary_text(const GatherResult& r)
       << fmt("%.4f", c.packing_mean[1]) << ", " << fmt("%.4f", c.packing_mean[2]) << " (" << c.packing_pairs[0] << ", "
       << c.packing_pairs[1] << ", " << c.packing_pairs[2] << " pairs; " << c.piles << " piles, " << c.bins << " bins, "
       << fmt("%.1f", c.packing_seconds) << " s)\n";
+  }
+  if (r.spin_test.run || r.spin == ResponseSpin::gyration) {
+    const SpinTest& t = r.spin_test;
+    s << "response spin: by " << (r.spin == ResponseSpin::gyration ? "gyration" : "length");
+    if (t.run)
+      s << "; KS of |V+| and |W+| of " << t.trials << " draws against the trials: by length " << fmt("%.4f", t.ks_length)
+        << ", by gyration " << fmt("%.4f", t.ks_gyration) << " (gyration taken below length - " << fmt("%.4f", t.critical)
+        << "); energy guard " << fmt("%.4f", t.clamp_length) << " / " << fmt("%.4f", t.clamp_gyration) << " ("
+        << fmt("%.1f", t.seconds) << " s)";
+    s << "\n";
   }
   if (r.landing.present()) {
     const LandingFit& l = r.landing;

@@ -25,6 +25,11 @@ std::vector<double> default_paper_speeds();    ///< 26 speeds for --layout paper
 std::vector<double> default_coarse_speeds();   ///< the coarse speed axis, m/s
 std::vector<double> default_landing_froude();  ///< 4 Froude numbers |V-|^2 / (g L): 0, 1, 4, 16
 
+/// The spin measure of the response table (--response-spin): statsim::ResponseSpin, or, by
+/// default, the one whose runtime draws match the trials' spins measurably better
+/// (gather_spin.hpp); `gyration` needs the landing data, which a table holds before it.
+enum class SpinOption { automatic, length, gyration };
+
 struct GatherOptions {
   std::string shape = "box";  ///< box, lshape, bunny (ignored when mesh_file is set)
   std::string mesh_file;      ///< any closed mesh `load_mesh` reads (btGImpactMeshShape)
@@ -41,6 +46,8 @@ struct GatherOptions {
   bool i16 = false;           ///< --precision i16
   /// How each cell's spread is stored (--response-model): see statsim::ResponseModel.
   ResponseModel response_model = ResponseModel::independent_gaussian;
+  /// What the response table's spin components measure (--response-spin): see SpinOption.
+  SpinOption response_spin = SpinOption::automatic;
   /// Outcomes kept per cell by the empirical model (--empirical-outcomes), 1 to `trials`.
   int empirical_outcomes = 16;
   unsigned threads = 0;       ///< 0 = all hardware threads

@@ -61,6 +61,14 @@ ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, doubl
   const Eigen::Vector3d w = ir.after.spin * (L / speed);
   const Eigen::Vector3d dv = (ir.after.velocity - vp.cast<double>()) / speed;
   out.value = {w.x(), w.y(), w.z(), dv.x(), dv.y(), dv.z()};
+  // K W+ / |V-| with K = R diag(sqrt(I_k / m)) R^T at the orientation the body leaves with, which
+  // belongs to W+: half its squared length is then the rotational energy the body leaves with. (At
+  // the orientation it met the ground with, after a long contact, it is not.)
+  const Eigen::Matrix3d R = ir.after.orientation.toRotationMatrix();
+  const Eigen::Vector3d k = R * (m.unit_inertia.cwiseSqrt().asDiagonal() * (R.transpose() * ir.after.spin)) / speed;
+  out.gyration = {k.x(), k.y(), k.z(), dv.x(), dv.y(), dv.z()};
+  out.contact = start;
+  out.departure = ir.after;
   out.time_limited = ir.time_limited;
   out.max_penetration = ir.max_penetration;
   out.steps = ir.steps;

@@ -14,12 +14,16 @@
 
 namespace statsim::tools::ref3d {
 
-/// One impact's normalised outcome: W+ L/|V-| (3), (V+ - V_particle+)/|V-| (3).
+/// One impact's normalised outcome: W+ L/|V-| (3), (V+ - V_particle+)/|V-| (3); or, with the
+/// spin measured by gyration (statsim::ResponseSpin), K W+ / |V-| for the first three.
 using Response = std::array<double, 6>;
 
 /// One response trial: W+ and V+ of one impact, and how Bullet got there.
 struct ResponseTrial {
-  Response value{};
+  Response value{};     ///< spin by length (statsim::ResponseSpin::length)
+  Response gyration{};  ///< the same outcome with the spin by gyration (statsim::ResponseSpin::gyration)
+  RigidState contact;   ///< the body as it met the ground: where the runtime's draws start (gather_spin.hpp)
+  RigidState departure; ///< the body as it left the ground (its orientation is K's in `gyration`)
   bool time_limited = false;
   double max_penetration = 0.0;
   int steps = 0;

@@ -1,5 +1,6 @@
 #include "ref3d/pairs.hpp"
 
+#include "common/ks_distance.hpp"
 #include "common/pi.hpp"
 
 #include "bullet/bullet.hpp"
@@ -308,23 +309,6 @@ PairOutcome runtime_pair_impact(const SignatureView<3>& sig, double L, const std
   o.speed = double((w->body(1).linear_velocity - w->body(0).linear_velocity).norm()) / u;
   o.spin = double(w->body(1).angular_velocity.norm()) * L / u;
   return o;
-}
-
-// Two-sample Kolmogorov-Smirnov distance.
-double ks(std::vector<double> a, std::vector<double> b)
-{
-  if (a.empty() || b.empty()) return 0.0;
-  std::sort(a.begin(), a.end());
-  std::sort(b.begin(), b.end());
-  std::size_t i = 0, j = 0;
-  double d = 0.0;
-  while (i < a.size() && j < b.size()) {
-    const double x = std::min(a[i], b[j]);
-    while (i < a.size() && a[i] <= x) ++i;
-    while (j < b.size() && b[j] <= x) ++j;
-    d = std::max(d, std::fabs(static_cast<double>(i) / static_cast<double>(a.size()) - static_cast<double>(j) / static_cast<double>(b.size())));
-  }
-  return d;
 }
 
 bool table_for(const std::string& name, SignatureView<3>& out)
@@ -672,10 +656,10 @@ PairResult gather_pairs(const PairOptions& options)
       bw2.push_back(ref_b[i].spin);
     }
     r.response_trials = static_cast<int>(n);
-    r.ks_speed = ks(bs, rs);
-    r.ks_spin = ks(bw, rw);
-    r.ks_speed_floor = ks(bs, bs2);
-    r.ks_spin_floor = ks(bw, bw2);
+    r.ks_speed = ks_distance(bs, rs);
+    r.ks_spin = ks_distance(bw, rw);
+    r.ks_speed_floor = ks_distance(bs, bs2);
+    r.ks_spin_floor = ks_distance(bw, bw2);
     r.bullet_speed = summarise(bs);
     r.bullet_spin = summarise(bw);
     r.runtime_speed = summarise(rs);

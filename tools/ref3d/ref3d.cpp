@@ -46,6 +46,7 @@ struct GatherCommand {
   std::string layout = "scaled";
   std::string precision = "f32";
   std::string response_model = "paper";
+  std::string response_spin = "auto";
   std::string mesh_shape = "gimpact";
   std::string out;
   std::string json;
@@ -204,6 +205,9 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.with_speed = c.layout == "paper";
     o.i16 = c.precision == "i16";
     o.response_model = parse_response_model(c.response_model);
+    o.response_spin = c.response_spin == "length"     ? SpinOption::length
+                      : c.response_spin == "gyration" ? SpinOption::gyration
+                                                      : SpinOption::automatic;
     o.reference.mesh_hull = c.mesh_shape == "hull";
     o.body_contacts = !c.no_body_contacts;
     // The landing data follows the body-body data in a table: a table of format 2.0 has neither.
@@ -361,6 +365,13 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
                   "Gaussians, paper 3.2.2); correlated = a Cholesky factor of the 6x6 covariance; empirical = "
                   "--empirical-outcomes stored trial outcomes")
       ->check(CLI::IsMember({"paper", "correlated", "empirical"}))
+      ->capture_default_str();
+  sub->add_option("--response-spin", c->response_spin,
+                  "What the response table's spin measures: length = W+ L / |V-| (the paper's); gyration = K W+ / "
+                  "|V-|, K the radii of gyration at the body's orientation, so a draw's rotational energy does not "
+                  "depend on how the body is turned (needs the landing data); auto = gyration only when the "
+                  "runtime's draws match the trials' spins measurably better (statsim/signature.hpp, ResponseSpin)")
+      ->check(CLI::IsMember({"auto", "length", "gyration"}))
       ->capture_default_str();
   sub->add_option("--empirical-outcomes", o.empirical_outcomes,
                   "Outcomes stored per cell by --response-model empirical (1 to --trials, at most 64)")

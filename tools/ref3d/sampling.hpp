@@ -17,7 +17,7 @@ namespace statsim::tools::ref3d {
 // committed tables depend on each value). gather: heights, responses, rest drops, and the checks
 // (kCheckStream and kCheckStream + 1); gather-pairs: pair flights (kPairStream to
 // kPairStream + 3), their heights and the bins; the landing stage's impacts with gravity and
-// the runtime's draws at their contacts.
+// the runtime's draws at their contacts; the spin measure's draws at the response trials'.
 constexpr std::uint64_t kHeightStream = 1;
 constexpr std::uint64_t kResponseStream = 2;
 constexpr std::uint64_t kRestStream = 3;
@@ -27,6 +27,7 @@ constexpr std::uint64_t kPairHeightStream = 12;
 constexpr std::uint64_t kBinStream = 16;
 constexpr std::uint64_t kLandingStream = 20;
 constexpr std::uint64_t kLandingDrawStream = 21;
+constexpr std::uint64_t kSpinDrawStream = 22;
 
 /// xoshiro256** seeded through SplitMix64 from (seed, stream, index).
 class TrialRng {

@@ -152,6 +152,14 @@ void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::
     else if (m == "empirical") s.model = ResponseModel::empirical;
     else fail(origin, "field 'response.model' is not \"paper\", \"correlated\" or \"empirical\"");
   }
+  // Files without "spin" (before table format 2.4) measure spin by length.
+  s.spin = ResponseSpin::length;
+  if (r.contains("spin")) {
+    const json& m = r.at("spin");
+    if (m == "length") s.spin = ResponseSpin::length;
+    else if (m == "gyration") s.spin = ResponseSpin::gyration;
+    else fail(origin, "field 'response.spin' is neither \"length\" nor \"gyration\"");
+  }
   std::vector<Scalar> mean = numbers(r, "mean", origin, "response.");
   std::vector<Scalar> spread = numbers(r, r.contains("spread") ? "spread" : "std", origin, "response.");
   expect_size(mean, cells * 6, "response.mean", origin);

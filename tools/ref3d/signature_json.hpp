@@ -5,8 +5,8 @@
 //
 // Fields read: name, length, bounding_radius, mass, unit_inertia, material {restitution,
 // friction, rolling_resistance}, restitution_threshold, h_coll {ratio, mean, std},
-// response {layout, model, axes [{values}], mean, spread, i16 {mean_scale, mean_offset,
-// spread_scale, spread_offset} (optional)}, rest [{normal, height, frequency}]. Files of table
+// response {layout, model, spin (optional: "length" when absent), axes [{values}], mean, spread,
+// i16 {mean_scale, mean_offset, spread_scale, spread_offset} (optional)}, rest [{normal, height, frequency}]. Files of table
 // format 1 (no "model"; "std" and std_scale / std_offset) load as the paper's model. When the JSON has "i16", the
 // response tables are quantised again by the generator's rule, statsim::quantize16 (which must
 // give the scales and offsets the JSON states), and used as 16-bit integers, as the generated
@@ -50,6 +50,7 @@ struct BasicLoadedSignature3 {
   Scalar restitution_threshold = 0;
   ResponseLayout layout = ResponseLayout::scaled;
   ResponseModel model = ResponseModel::independent_gaussian;
+  ResponseSpin spin = ResponseSpin::length;
   std::uint32_t axis_count = 0;  ///< 3 (scaled) or 4 (with_speed)
   std::vector<Scalar> height_axis, height_mean, height_stddev;
   std::vector<Scalar> axis0, axis1, axis2, axis3;
