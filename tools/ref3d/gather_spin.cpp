@@ -64,17 +64,13 @@ void choose_spin(GatherResult& r, const std::vector<ResponseTrial>& all)
   GatherResult g = r;
   static_cast<ResponseFit&>(g) = fit_responses(with_gyration(all), trials, nt, np, nv, o.spin_ratios);
   g.spin = ResponseSpin::gyration;
-  // The trials' |V+| = |V_particle+ + dv |V-|| and |W+| L / |V-|, over |V-|.
-  const Material material{static_cast<Scalar>(o.reference.restitution), static_cast<Scalar>(o.reference.friction),
-                          static_cast<Scalar>(o.rolling_resistance)};
+  // The trials' |V+| / |V-| and |W+| L / |V-|, from the state each body left the ground with.
+  const double L = r.model.bounding_radius;
   std::vector<double> speed(all.size()), spin(all.size());
   for (std::size_t i = 0; i < all.size(); ++i) {
-    const Response& x = all[i].value;
     const double u = all[i].contact.velocity.norm();
-    const Vector3 vp = point_particle_velocity<3>(all[i].contact.velocity.cast<Scalar>(), Vector3(0, 0, 1), material,
-                                                  static_cast<Scalar>(o.reference.restitution_threshold));
-    speed[i] = (vp.cast<double>() + Eigen::Vector3d(x[3], x[4], x[5]) * u).norm() / u;
-    spin[i] = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    speed[i] = all[i].departure.velocity.norm() / u;
+    spin[i] = all[i].departure.spin.norm() * L / u;
   }
   const Draws by_length = draw_spins(r, all), by_gyration = draw_spins(g, all);
   SpinTest t;

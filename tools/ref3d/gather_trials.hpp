@@ -23,7 +23,7 @@ struct ResponseTrial {
   Response value{};     ///< spin by length (statsim::ResponseSpin::length)
   Response gyration{};  ///< the same outcome with the spin by gyration (statsim::ResponseSpin::gyration)
   RigidState contact;   ///< the body as it met the ground: where the runtime's draws start (gather_spin.hpp)
-  RigidState departure; ///< the body as it left the ground (its orientation is K's in `gyration`)
+  RigidState departure; ///< the body as it left the ground (W+ and V+; its orientation is K's in `gyration`)
   bool time_limited = false;
   double max_penetration = 0.0;
   int steps = 0;
