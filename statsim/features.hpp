@@ -29,8 +29,9 @@ enum class Features : std::uint32_t {
   hull_contacts = 1u << 1,
   /// Tilted planes (`detail::is_tilted_plane`: gravity pulls along a plane that carries weight):
   /// statistical bodies roll and tumble down them at their hulls, and plain spheres meet them as
-  /// on any plane. Without it `add_plane` refuses a tilted plane, and `configure` a gravity that
-  /// tilts a plane already added.
+  /// on any plane; with `WorldDef::ground_hulls`, level ground after a body's first impact too.
+  /// Without it `add_plane` refuses a tilted plane, and `configure` a gravity that tilts a plane
+  /// already added or ground hulls.
   slopes = 1u << 2,
   /// Ray casts and sphere overlaps (statsim/queries.hpp), which search the broad phase's records
   /// that each step then widens by how far bodies moved. Without it the queries return

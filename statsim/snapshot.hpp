@@ -90,7 +90,7 @@ void write_def(SnapshotWriter& out, const WorldDef<D>& d)
   out.u32(d.grid_above_bodies);
   for (std::uint32_t b : {std::uint32_t(d.table_restitution_threshold), std::uint32_t(d.shock_propagation),
                           std::uint32_t(d.nearest_radius), std::uint32_t(d.pair_response),
-                          std::uint32_t(d.body_contacts), std::uint32_t(d.rest_conditions),
+                          std::uint32_t(d.body_contacts), std::uint32_t(d.rest_conditions) | (d.ground_hulls ? 2u : 0u),
                           std::uint32_t(d.pile_rest), std::uint32_t(d.broad_phase), std::uint32_t(d.sleep_islands)})
     out.u8(b);
 }
@@ -113,15 +113,18 @@ bool read_def(SnapshotReader& in, WorldDef<D>& d)
   d.grid_above_bodies = in.u32();
   std::uint8_t b[9];
   for (std::uint8_t& x : b) x = in.u8();
+  // b[4]: BodyContacts, up to `automatic`; b[5]: rest conditions (bit 0) and ground hulls (bit 1),
+  // which snapshots from before the option hold 0.
   for (int i = 0; i < 7; ++i)
-    if (b[i] > (i == 4 ? 2 : 1)) return false;  // b[4]: BodyContacts, up to `automatic`
+    if (b[i] > (i == 4 ? 2 : i == 5 ? 3 : 1)) return false;
   if (b[7] > 2 || b[8] > 1) return false;
   d.table_restitution_threshold = b[0] != 0;
   d.shock_propagation = b[1] != 0;
   d.nearest_radius = b[2] != 0;
   d.pair_response = PairResponse(b[3]);
   d.body_contacts = BodyContacts(b[4]);
-  d.rest_conditions = b[5] != 0;
+  d.rest_conditions = (b[5] & 1u) != 0;
+  d.ground_hulls = (b[5] & 2u) != 0;
   d.pile_rest = b[6] != 0;
   d.broad_phase = BroadPhase(b[7]);
   d.sleep_islands = b[8] != 0;

@@ -303,6 +303,7 @@ class WorldCore {
     std::uint32_t* awake;
     std::uint32_t* flagged;
     std::uint32_t* rolled;
+    std::uint32_t* grounded;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
     Impact<D>* impacts;
     std::uint32_t max_impacts;
@@ -338,13 +339,20 @@ class WorldCore {
     const auto id = [this](std::uint32_t slot) { return id_of(slot); };
     impacts_.count = 0;
     impacts_.found = 0;
+    // With ground hulls, both bit sets every step: the passes read `rolled` for level ground too
+    // (`respond_alone`), and it holds the islands' marks of the last step.
+    const bool ground_hulls = FS::slopes && w_.def.ground_hulls;
     if constexpr (FS::slopes) {
-      if (w_.tilted_planes)
+      if (w_.tilted_planes || ground_hulls)
         for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) w_.rolled[k] = 0;
+      if (ground_hulls)
+        for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) w_.grounded[k] = 0;
     }
     result.bodies_integrated = detail::integrate<FS>(w_, dt, [&](std::uint32_t i) {
       if constexpr (FS::slopes) {
-        return w_.tilted_planes && detail::roll_on_slopes<FS>(w_, i, dt, impacts_, id);
+        // `on_ground` is still last step's: `forget_contacts` clears it below.
+        if (ground_hulls && w_.bodies[i].on_ground) detail::set_bit(w_.grounded, i);
+        return (w_.tilted_planes || ground_hulls) && detail::roll_on_slopes<FS>(w_, i, dt, impacts_, id);
       } else {
         (void)i;
         return false;
@@ -400,6 +408,7 @@ class WorldCore {
            s.awake,
            s.flagged,
            s.rolled,
+           s.grounded,
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
@@ -479,7 +488,8 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                          StorageBase::body_store.data(), StorageBase::broad_phase_store.data(),
                          StorageBase::pair_store.data(), StorageBase::plane_store.data(),
                          StorageBase::shape_store.data(), StorageBase::awake_store.data(),
-                         StorageBase::flagged_store.data(), StorageBase::rolled_store.data(), MaxBodies, MaxPairs,
+                         StorageBase::flagged_store.data(), StorageBase::rolled_store.data(),
+                         StorageBase::grounded_store.data(), MaxBodies, MaxPairs,
                          MaxPlanes, MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
                          StorageBase::generation_store.data(), StorageBase::free_store.data(), StorageBase::grid,
                          StorageBase::pair_hull_store.data(), std::uint32_t(StorageBase::pair_hull_store.size()), F,

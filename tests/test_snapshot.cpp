@@ -138,6 +138,23 @@ TEST_CASE("snapshot: a loaded 3D pile steps on bit for bit (hull contacts, pile 
   check_scene<3, World3s>(def, 200);
 }
 
+TEST_CASE("snapshot: a loaded 3D pile with ground hulls steps on bit for bit")
+{
+  WorldDef3 def;
+  def.ground_hulls = true;
+  for (int at : {60, 150}) check_scene<3, World3s>(def, at);
+  // Snapshots keep the option (in the rest conditions' byte, so that older snapshots load with it
+  // off).
+  auto a = std::make_unique<World3s>(def);
+  REQUIRE(add_snapshot_shapes<3>(*a));
+  std::vector<unsigned char> on(snapshot_size(*a));
+  REQUIRE(save(*a, on.data(), on.size(), nullptr) == Status::ok);
+  auto b = std::make_unique<World3s>();
+  REQUIRE(add_snapshot_shapes<3>(*b));
+  REQUIRE(load(*b, on.data(), on.size()) == Status::ok);
+  CHECK(b->def().ground_hulls);
+}
+
 TEST_CASE("snapshot: a loaded 2D pile steps on bit for bit")
 {
   WorldDef2 def;

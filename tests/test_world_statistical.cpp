@@ -4,16 +4,19 @@
 #include "scenes/synthetic_signatures.hpp"
 #include "support/world_states.hpp"
 
+#include "statsim/random.hpp"
 #include "statsim/world2.hpp"
 #include "statsim/world3.hpp"
 #include "tables/box.hpp"
 #include "tables/bunny.hpp"
 #include "tables/lshape.hpp"
+#include "tables/lshape2d.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 using namespace statsim;
 using statsim::testing::cube_synthetic;
@@ -430,4 +433,90 @@ TEST_CASE("L-shapes that keep a rest pose on top of others fall asleep")
   }
   MESSAGE("all asleep after ", steps, " steps");
   CHECK(lshape_world.count(MotionState::asleep) == 300);
+}
+
+namespace {
+/// Drops `n` bodies of table `sig` apart onto level ground, each alone, with `WorldDef::ground_hulls`
+/// as `hulls`, and counts the steps that begin with a body on the ground and end with it awake
+/// (`on_ground`), those of them that end with its hull in the ground (the centre below the hull's
+/// support toward the ground by more than a thousandth of the bounding radius), and the
+/// statistical responses of all steps.
+template <int D, class World>
+void ground_steps(const SignatureView<D>& sig, int n, bool hulls, int& grounded, int& sunk, std::uint64_t& responses)
+{
+  using Vec = typename Space<D>::Vec;
+  constexpr int up = Space<D>::up_axis;
+  WorldDef<D> def;
+  def.ground_hulls = hulls;
+  auto w = std::make_unique<World>(def);
+  REQUIRE(w->construction_status() == Status::ok);
+  const ShapeId shape = w->add_shape(sig).id;
+  REQUIRE(w->add_plane(Vec::Unit(up), 0).ok());
+  const Scalar bound = w->shape(shape).bounding_radius;
+  Pcg32 g(19, 7);
+  for (int i = 0; i < n; ++i) {
+    BodyDef<D> b;
+    b.shape = shape;
+    b.position = Vec::Zero();
+    b.position[0] = Scalar(6) * Scalar(i);
+    b.position[up] = bound + g.uniform(0.1f, 0.6f);
+    b.orientation = statsim::random_orientation<D>(g);
+    REQUIRE(w->add_body(b).ok());
+  }
+  grounded = sunk = 0;
+  responses = 0;
+  std::vector<char> before(std::size_t(n), 0);
+  for (int s = 0; s < 600; ++s) {
+    for (int i = 0; i < n; ++i) before[std::size_t(i)] = w->body(std::uint32_t(i)).on_ground;
+    const StepResult r = w->step(Scalar(1) / 60);
+    REQUIRE(r.ok());
+    responses += r.statistical_responses;
+    for (int i = 0; i < n; ++i) {
+      const Body<D>& b = w->body(std::uint32_t(i));
+      if (!before[std::size_t(i)] || b.state == MotionState::asleep) continue;
+      ++grounded;
+      const Scalar support = detail::support_along(sig.contact, detail::to_body(b.orientation, Vec(-Vec::Unit(up))));
+      sunk += b.position[up] < support - Scalar(1e-3) * bound;
+    }
+  }
+}
+}  // namespace
+
+TEST_CASE("ground hulls: after the first impact a body on level ground stands on its hull, not in it (3D and 2D)")
+{
+  // The first impact from flight is the table's response; with `WorldDef::ground_hulls` a body
+  // that was on the ground as a step began meets it with its hull (`detail::ground_hull`), as a
+  // rigid body tumbles over its edges, where its collision sphere lets its corners sink in.
+  for (const bool hulls : {true, false}) {
+    CAPTURE(hulls);
+    int grounded = 0, sunk = 0;
+    std::uint64_t responses = 0;
+    ground_steps<3, World3<32>>(tables::lshape.view(), 32, hulls, grounded, sunk, responses);
+    MESSAGE("3D: " << grounded << " steps on the ground, " << sunk << " of them sunk, " << responses << " responses");
+    CHECK(grounded > 200);
+    CHECK(responses >= 32);
+    if (hulls) CHECK(sunk == 0);
+    else CHECK(sunk > 20);  // the spheres' rule, which the option replaces
+    ground_steps<2, World2<32>>(tables::lshape2d.view(), 32, hulls, grounded, sunk, responses);
+    MESSAGE("2D: " << grounded << " steps on the ground, " << sunk << " of them sunk, " << responses << " responses");
+    CHECK(grounded > 200);
+    CHECK(responses >= 32);
+    if (hulls) CHECK(sunk == 0);
+    else CHECK(sunk > 20);
+  }
+}
+
+TEST_CASE("ground hulls: refused without Features::slopes, the world unchanged")
+{
+  WorldDef3 def;
+  def.ground_hulls = true;
+  auto w = std::make_unique<World3<4, 8, 24, 8, 0, BroadPhase::automatic, Features::piles>>(def);
+  CHECK(w->construction_status() == Status::not_compiled);
+  CHECK_FALSE(w->def().ground_hulls);  // it took the defaults
+  const std::uint64_t before = w->state_hash();
+  CHECK(w->configure(def) == Status::not_compiled);
+  CHECK(w->state_hash() == before);
+  auto all = std::make_unique<World3<4>>();
+  CHECK(all->configure(def) == Status::ok);
+  CHECK(all->def().ground_hulls);
 }

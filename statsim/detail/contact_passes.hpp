@@ -69,8 +69,10 @@ void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, cons
   // impacts included (statsim/detail/slope_contact.hpp): how far it tumbles and rolls downhill follows
   // from the strikes of its faces one after the other, each set by the last, which independent
   // samples of the tables' single-impact responses do not reproduce. A body that rolled through
-  // the step in substeps (`roll_on_slopes`) has had its slope contacts there.
-  if (tilted_plane && rolls_on<FS>(w, b, n)) {
+  // the step in substeps (`roll_on_slopes`) has had its slope contacts there. On level ground
+  // the same holds for a body that was on the ground as the step began (`ground_hull`): its
+  // tumbles and hops after the first impact are its hull's.
+  if ((tilted_plane || ground_contact) && rolls_on<FS>(w, b, n)) {
     if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)))
       slope_hull_response(shape, b, n, def.gravity, gap, ctx.dt, threshold);
     return;
@@ -225,7 +227,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext<FS>& ctx, bool grown, 
       // (a speculative contact: `slope_hull_response` lets it close the gap in the step and no
       // more): turning about a corner, the hull's support falls away from the plane by about
       // (1 - cos(w dt)) times the support in a step, and the corner would lose the plane.
-      const bool hull = FS::slopes && ctx.tilted_planes && rolls_on<FS>(w, b, w.planes[p].normal);
+      const bool hull = FS::slopes && rolls_on<FS>(w, b, w.planes[p].normal);
       const Scalar slop = hull ? w.shapes[b.shape].bounding_radius * slope_reach
                                : (grown ? b.radius * contact_slop : Scalar(0));
       if (!sphere_plane_contact<D>(b.position, plane_radius<FS>(w, b, w.planes[p]) + slop, w.planes[p], c)) continue;
@@ -321,6 +323,9 @@ void forget_contacts(WorldData<D>& w)
 template <int D, class FS>
 void support_planes(WorldData<D>& w, StepContext<FS>& ctx)
 {
+  // On level ground a body that rolled on its hull in the step's substeps (`ground_hull`) meets
+  // it here as every other resting body does, at its sphere: what approach the substeps left at
+  // the step's end goes, and friction there brakes its slide and spin.
   plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool tilted) {
     if (tilted && rolls_on<FS>(w, b, c.normal)) {
       if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)) &&

@@ -25,12 +25,13 @@ Status check_plane_features(Features f, const Vec& g, const Vec& n)
 }
 
 /// `not_compiled` when parameters `def` ask for hull contacts of a world of features `f` without
-/// `Features::hull_contacts`, else `ok`.
+/// `Features::hull_contacts`, or for ground hulls (`WorldDef::ground_hulls`, the slopes' contact)
+/// without `Features::slopes`, else `ok`.
 template <int D>
 Status check_def_features(Features f, const WorldDef<D>& def)
 {
-  return def.body_contacts == BodyContacts::hulls && !includes(f, Features::hull_contacts) ? Status::not_compiled
-                                                                                           : Status::ok;
+  if (def.body_contacts == BodyContacts::hulls && !includes(f, Features::hull_contacts)) return Status::not_compiled;
+  return def.ground_hulls && !includes(f, Features::slopes) ? Status::not_compiled : Status::ok;
 }
 
 /// `not_compiled` when the parameters `def` need a feature the world `w` lacks: hull contacts, or

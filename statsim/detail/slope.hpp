@@ -2,7 +2,8 @@
 /// @file
 /// Which contacts with planes a body meets at its hull rather than its collision sphere: a
 /// tilted plane (`is_tilted_plane`) for a statistical body with a support map (`slope_hull`),
-/// and a settling body with hull contacts (`hull_radius`). What happens at those contacts is
+/// level ground after the first impact (`ground_hull`), and a settling body that other bodies
+/// hold (`hull_radius`). What happens at those contacts is
 /// slope_contact.hpp's.
 
 #include "statsim/detail/hull.hpp"
@@ -34,10 +35,20 @@ bool any_tilted_plane(const WorldData<D>& w)
   return false;
 }
 
+/// True when the bodies of shape `s` can meet a plane with their hull: statistical, with a
+/// support map and principal moments.
+template <int D>
+bool hull_shape(const Shape<D>& s)
+{
+  if (!s.statistical || !s.signature.contact.present()) return false;
+  for (int k = 0; k < (D == 3 ? 3 : 1); ++k)
+    if (!(s.signature.unit_inertia[std::size_t(k)] > 0)) return false;
+  return true;
+}
+
 /// True when body `b` meets the plane of unit normal `n` with its hull, as a rigid body would
 /// (statsim/detail/slope_contact.hpp): the plane is tilted (`is_tilted_plane`) and the body statistical,
-/// with a support map and principal moments. On level ground and walls bodies keep their
-/// collision spheres.
+/// with a support map and principal moments (`hull_shape`).
 template <class FS = AllFeatures, int D>
 bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
 {
@@ -45,24 +56,48 @@ bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>
     return false;
   }
   if (!w.tilted_planes) return false;
-  const Shape<D>& s = w.shapes[b.shape];
-  if (!s.statistical || !s.signature.contact.present()) return false;
-  for (int k = 0; k < (D == 3 ? 3 : 1); ++k)
-    if (!(s.signature.unit_inertia[std::size_t(k)] > 0)) return false;
+  if (!hull_shape(w.shapes[b.shape])) return false;
   Scalar gn;
   return is_tilted_plane(w.def.gravity, n, gn);
 }
 
-/// True when body `b` meets a plane of unit normal `n` (towards the body) with its hull
-/// (`slope_hull`) and has no rest pose chosen: its contacts there are `slope_hull_response`'s.
+/// True when body `b` meets the plane of unit normal `n` with its hull because it is level ground
+/// (it carries weight, and gravity has no part along it) that the body was on at the start of the
+/// step (`WorldData::grounded`), the body statistical with a support map and principal moments.
+/// The statistical response stands for a collision as a whole: the tables give what a rigid body
+/// leaves the ground with after it, however many times its corners strike within it. A body
+/// already on the ground, though, tumbles over its edges and hops on its corners, each strike set
+/// by the one before; drawing a fresh collision at each contact would make a sphere bounce where
+/// the rigid body rocks, and a sphere that rolls cannot hop. So the first impact from flight is
+/// the table's, and the contacts after it are the hull's, as on a slope, until a rest pose is
+/// chosen (`rolls_on`). Only with `WorldDef::ground_hulls` and `rest_conditions` (without them
+/// bodies stay the paper's spheres), in worlds with `Features::slopes`.
+template <class FS = AllFeatures, int D>
+bool ground_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  if constexpr (!FS::slopes || !FS::statistical) {
+    return false;
+  }
+  if (!w.def.ground_hulls || !w.def.rest_conditions || !bit_set(w.grounded, std::uint32_t(&b - w.bodies))) return false;
+  if (!hull_shape(w.shapes[b.shape])) return false;
+  Scalar gn;
+  return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
+}
+
+/// True when body `b` (one of `w`'s bodies, not a copy) meets a plane of unit normal `n` (towards
+/// the body) with its hull (`slope_hull`, `ground_hull`) and has no rest pose chosen: its
+/// contacts there are `slope_hull_response`'s.
 template <class FS = AllFeatures, int D>
 bool rolls_on(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
 {
-  return b.rest_pose == no_rest_pose && slope_hull<FS>(w, b, n);
+  return b.rest_pose == no_rest_pose && (slope_hull<FS>(w, b, n) || ground_hull<FS>(w, b, n));
 }
 
-/// The radius a body keeps from a plane of normal `n`: its collision radius, or its hull's
-/// support toward the plane on a slope (`slope_hull`), or, for a settling body with a hull
+/// The radius a body (one of `w`'s bodies, not a copy) keeps from a plane of normal `n`: its
+/// collision radius; or its hull's support toward the plane on a slope (`slope_hull`) or on level
+/// ground it was on as the step began (`ground_hull`: with a rest pose too, so that the body that
+/// takes one turns into it on its hull, as it stood, instead of jumping to its collision radius);
+/// or, for a settling body with a hull
 /// (`BodyContacts::hulls`), at least its hull's support toward the plane, so that a body resting
 /// out of its rest poses (propped by others) does not sink its hull into the ground or a wall.
 template <class FS = AllFeatures, int D>
@@ -72,7 +107,7 @@ Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
     return b.radius;
   }
   const Shape<D>& s = w.shapes[b.shape];
-  if (slope_hull<FS>(w, b, n))
+  if (slope_hull<FS>(w, b, n) || ground_hull<FS>(w, b, n))
     return support_along(s.signature.contact, to_body(b.orientation, typename Space<D>::Vec(-n)));
   if (!(FS::hull_contacts && hull_contacts_on(w)) || b.state != MotionState::settling || !s.statistical ||
       !s.signature.contact.present())
@@ -88,9 +123,11 @@ Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& pla
 {
   // `hull_radius`'s first tests, before the plane's distance: every body meets every plane in
   // every pass, and most need neither.
+  const std::uint32_t i = std::uint32_t(&b - w.bodies);
   const bool slopes = FS::slopes && w.tilted_planes;
+  const bool ground = FS::slopes && w.def.ground_hulls && bit_set(w.grounded, i);
   const bool hulls = FS::hull_contacts && hull_contacts_on(w) && b.state == MotionState::settling;
-  if (!slopes && !hulls) return b.radius;
+  if (!slopes && !ground && !hulls) return b.radius;
   if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
   return hull_radius<FS>(w, b, plane.normal);
 }

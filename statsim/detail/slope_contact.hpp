@@ -15,7 +15,12 @@
 /// into a roll; the impulse that stops the next corner as it strikes takes what a rigid body
 /// loses there; a face whose extent downhill holds the line of gravity holds the body still.
 /// No table holds anything for this: the support map and the principal moments are the table's
-/// own. Level ground and walls are not affected.
+/// own. With `WorldDef::ground_hulls` the same contact follows a body's first impact on level
+/// ground (`ground_hull`): the statistical response gives what it leaves the ground with, and its
+/// hull the tumbles and hops after it, until it takes a rest pose, in the same substeps: taken at
+/// the step's length, the corner strikes of a tumble take out what a rigid body at that step loses,
+/// and it stops on other faces than the reference's (tools/fidelity/LOG.md measures both). Walls
+/// are not affected.
 
 #include "statsim/detail/events.hpp"
 #include "statsim/detail/hull.hpp"
@@ -202,8 +207,8 @@ Scalar restitution_threshold(const WorldData<D>& w, const Body<D>& b, const type
 constexpr Scalar slope_contact_step = Scalar(0.001);
 
 /// Moves awake body `i` through a step of `dt` seconds in substeps of at most
-/// `slope_contact_step` when it touched something in the last step and `rolls_on` a slope that it
-/// is within `slope_reach` of: gravity, damping, the contacts with every
+/// `slope_contact_step` when it touched something in the last step and `rolls_on` a plane (a
+/// slope, or level ground it was on, `ground_hull`) that it is within `slope_reach` of: gravity, damping, the contacts with every
 /// such slope (`slope_hull_response`, the body kept out of the plane) and the move, in each
 /// substep. Its impacts with those slopes faster than `WorldDef::impact_threshold` go to `log`
 /// (each substep's, with the approach speed of the centre, as `record_impacts` measures it).

@@ -31,6 +31,7 @@ void hash_def(Fnv1a& h, const WorldDef<D>& d)
   if (d.body_contacts != BodyContacts::collision_spheres) h.add(std::uint8_t(d.body_contacts));
   if (d.impact_threshold != WorldDef<D>{}.impact_threshold) h.add(d.impact_threshold);
   if (d.sleep_islands) h.add(std::uint8_t(0x51));
+  if (d.ground_hulls) h.add(std::uint8_t(0x47));
 }
 
 /// Adds a table's numbers as the runtime reads them (16-bit ones as their values).

@@ -64,6 +64,7 @@ const std::vector<WorldSetting>& world_settings()
       STATSIM_SETTING(angular_damping, "1/s", false, 0, 1000, to<Scalar>),
       STATSIM_SETTING(pile_rest, "0 or 1", true, 0, 1, to<bool>),
       STATSIM_SETTING(sleep_islands, "0 or 1", true, 0, 1, to<bool>),
+      STATSIM_SETTING(ground_hulls, "0 or 1 (compiles Features::slopes)", true, 0, 1, to<bool>),
   };
   return all;
 }
@@ -310,7 +311,7 @@ std::unique_ptr<Sim> make_capacity(const ShapeSet<D>& sig, const Scene& scene, s
 
 /// A world of the features the scene uses, as a user would compile it (statsim/features.hpp):
 /// statistical shapes, hull contacts where the variant asks for them, slopes where a wall is
-/// tilted; every feature with `StatsimVariant::all_features`. 3D only: the 2D bench keeps every
+/// tilted or the variant sets `ground_hulls`; every feature with `StatsimVariant::all_features`. 3D only: the 2D bench keeps every
 /// feature, so that the tool compiles a third as many steps.
 template <int D, class Scene>
 std::unique_ptr<Sim> make_sized(const ShapeSet<D>& sig, const Scene& scene, std::uint64_t seed, double dt,
@@ -318,12 +319,13 @@ std::unique_ptr<Sim> make_sized(const ShapeSet<D>& sig, const Scene& scene, std:
                                 const std::vector<bullet::Plane>& w = {})
 {
   if constexpr (D == 3) {
-    bool tilted = false;
+    bool slopes = false;
     for (const bullet::Plane& p : w) {
       Scalar gn;
-      tilted = tilted || detail::is_tilted_plane(WorldDef3{}.gravity, Vector3(p.normal.cast<Scalar>().normalized()), gn);
+      slopes = slopes || detail::is_tilted_plane(WorldDef3{}.gravity, Vector3(p.normal.cast<Scalar>().normalized()), gn);
     }
-    if (!v.all_features && !tilted) {
+    for (const auto& [name, value] : v.settings) slopes = slopes || (name == "ground_hulls" && value != 0);
+    if (!v.all_features && !slopes) {
       if (v.hull_contacts) return make_capacity<D, Features::piles>(sig, scene, seed, dt, broad_phase, v, w);
       return make_capacity<D, Features::paper>(sig, scene, seed, dt, broad_phase, v, w);
     }

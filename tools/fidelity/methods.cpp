@@ -284,9 +284,9 @@ Setup make_setup(const FidelityOptions& o)
     const std::string name = full_name.substr(0, full_name.find('+'));
     const std::vector<std::pair<std::string, double>> settings = world_settings_of(full_name);
     if (!settings.empty() && name != "statistical" && name != "statistical-norest" &&
-        name != "statistical-independent" && name != "statistical-spheres")
+        name != "statistical-independent" && name != "statistical-spheres" && name.rfind("statistical:", 0) != 0)
       throw std::invalid_argument("method " + full_name + ": WorldDef settings (+FIELD=VALUE) go after statistical, "
-                                  "statistical-norest, statistical-independent or statistical-spheres");
+                                  "statistical-norest, statistical-independent, statistical-spheres or statistical:NAME");
     if (s.mixed && name.rfind("statistical:", 0) == 0) {
       if (o.methods.empty()) continue;
       throw std::invalid_argument("method " + name + ": --mix takes the compiled tables only");
@@ -328,6 +328,8 @@ Setup make_setup(const FidelityOptions& o)
       m.table = it->view();
       m.table_bytes = static_cast<long long>(it->bytes());
       m.description = "statsim, " + it->path + (it->i16() ? " (i16)" : " (f32)");
+      m.variant.settings = settings;
+      for (const auto& [field, value] : settings) m.description += ", " + field + " = " + format_setting(value);
     } else {
       throw std::invalid_argument("unknown method '" + name +
                                   "' (full, full-gather, low, hull, spheres7, sphere, statistical, statistical-norest, "
