@@ -339,20 +339,19 @@ class WorldCore {
     const auto id = [this](std::uint32_t slot) { return id_of(slot); };
     impacts_.count = 0;
     impacts_.found = 0;
-    // With ground hulls, both bit sets every step: the passes read `rolled` for level ground too
-    // (`respond_alone`), and it holds the islands' marks of the last step.
-    const bool ground_hulls = FS::slopes && w_.def.ground_hulls;
-    if constexpr (FS::slopes) {
-      if (w_.tilted_planes || ground_hulls)
-        for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) w_.rolled[k] = 0;
-      if (ground_hulls)
-        for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) w_.grounded[k] = 0;
-    }
+    // `rolled` every step that may roll: the passes read it (`respond_alone`), and it holds the
+    // islands' marks of the last step.
+    const bool hull_planes = detail::hull_planes<FS>(w_), ground_hulls = FS::slopes && w_.def.ground_hulls;
+    if (hull_planes)
+      for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) {
+        w_.rolled[k] = 0;
+        if (ground_hulls) w_.grounded[k] = 0;
+      }
     result.bodies_integrated = detail::integrate<FS>(w_, dt, [&](std::uint32_t i) {
       if constexpr (FS::slopes) {
         // `on_ground` is still last step's: `forget_contacts` clears it below.
         if (ground_hulls && w_.bodies[i].on_ground) detail::set_bit(w_.grounded, i);
-        return (w_.tilted_planes || ground_hulls) && detail::roll_on_slopes<FS>(w_, i, dt, impacts_, id);
+        return hull_planes && detail::roll_on_slopes<FS>(w_, i, dt, impacts_, id);
       } else {
         (void)i;
         return false;

@@ -227,7 +227,7 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext<FS>& ctx, bool grown, 
       // (a speculative contact: `slope_hull_response` lets it close the gap in the step and no
       // more): turning about a corner, the hull's support falls away from the plane by about
       // (1 - cos(w dt)) times the support in a step, and the corner would lose the plane.
-      const bool hull = FS::slopes && rolls_on<FS>(w, b, w.planes[p].normal);
+      const bool hull = hull_planes<FS>(w) && rolls_on<FS>(w, b, w.planes[p].normal);
       const Scalar slop = hull ? w.shapes[b.shape].bounding_radius * slope_reach
                                : (grown ? b.radius * contact_slop : Scalar(0));
       if (!sphere_plane_contact<D>(b.position, plane_radius<FS>(w, b, w.planes[p]) + slop, w.planes[p], c)) continue;

@@ -49,7 +49,7 @@ void record_impacts(const WorldData<D>& w, ImpactLog<D>& log, IdOf&& id_of)
     for (std::uint32_t p = 0; p < w.plane_count; ++p) {
       const Plane<D>& plane = w.planes[p];
       Contact<D> c;
-      if (FS::slopes && bit_set(w.rolled, i) && rolls_on<FS>(w, b, plane.normal)) continue;
+      if (hull_planes<FS>(w) && bit_set(w.rolled, i) && rolls_on<FS>(w, b, plane.normal)) continue;
       if (!sphere_plane_contact<D>(b.position, plane_radius<FS>(w, b, plane), plane, c)) continue;
       const Scalar approach = -b.linear_velocity.dot(c.normal);
       if (!(approach > threshold)) continue;

@@ -250,7 +250,8 @@ void update_motion_states(WorldData<D>& w, Scalar dt, std::uint32_t touching)
     // A body rolling on its hull, down a slope or on level ground after its first impact
     // (statsim/detail/slope_contact.hpp), takes a pose only once its contacts have all but stopped
     // it there: the faces it rolls over are not poses it rests in.
-    const bool rolling = settling && b.on_ground && speed2 >= sleep2 && rolls_on<FS>(w, b, ground);
+    const bool rolling =
+        hull_planes<FS>(w) && settling && b.on_ground && speed2 >= sleep2 && rolls_on<FS>(w, b, ground);
     const SlopeSettle slope = rolling                                   ? SlopeSettle::tipping
                               : tilted_planes && settling && b.on_ground ? settle_on_slope<FS>(w, b, ground)
                                                                          : SlopeSettle::pose;

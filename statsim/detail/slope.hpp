@@ -84,6 +84,15 @@ bool ground_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D
   return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
 }
 
+/// True when some body may meet a plane with its hull (`rolls_on`): the world has a tilted plane
+/// or `WorldDef::ground_hulls`. The step tests it before `rolls_on` in its loops over bodies and
+/// planes, which then cost nothing in worlds that have neither.
+template <class FS = AllFeatures, int D>
+bool hull_planes(const WorldData<D>& w)
+{
+  return FS::slopes && (w.tilted_planes || w.def.ground_hulls);
+}
+
 /// True when body `b` (one of `w`'s bodies, not a copy) meets a plane of unit normal `n` (towards
 /// the body) with its hull (`slope_hull`, `ground_hull`) and has no rest pose chosen: its
 /// contacts there are `slope_hull_response`'s.

@@ -208,8 +208,8 @@ constexpr Scalar slope_contact_step = Scalar(0.001);
 
 /// Moves awake body `i` through a step of `dt` seconds in substeps of at most
 /// `slope_contact_step` when it touched something in the last step and `rolls_on` a plane (a
-/// slope, or level ground it was on, `ground_hull`) that it is within `slope_reach` of: gravity, damping, the contacts with every
-/// such slope (`slope_hull_response`, the body kept out of the plane) and the move, in each
+/// slope, or level ground it was on, `ground_hull`) that it is within `slope_reach` of: gravity,
+/// damping, the contacts with every such slope (`slope_hull_response`, the body kept out of the plane) and the move, in each
 /// substep. Its impacts with those slopes faster than `WorldDef::impact_threshold` go to `log`
 /// (each substep's, with the approach speed of the centre, as `record_impacts` measures it).
 /// Marks the body in `WorldData::rolled`: the step's contact passes leave its slope contacts

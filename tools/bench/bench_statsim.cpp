@@ -311,8 +311,8 @@ std::unique_ptr<Sim> make_capacity(const ShapeSet<D>& sig, const Scene& scene, s
 
 /// A world of the features the scene uses, as a user would compile it (statsim/features.hpp):
 /// statistical shapes, hull contacts where the variant asks for them, slopes where a wall is
-/// tilted or the variant sets `ground_hulls`; every feature with `StatsimVariant::all_features`. 3D only: the 2D bench keeps every
-/// feature, so that the tool compiles a third as many steps.
+/// tilted or the variant sets `ground_hulls`; every feature with `StatsimVariant::all_features`.
+/// 3D only: the 2D bench keeps every feature, so that the tool compiles a third as many steps.
 template <int D, class Scene>
 std::unique_ptr<Sim> make_sized(const ShapeSet<D>& sig, const Scene& scene, std::uint64_t seed, double dt,
                                 const std::string& broad_phase, const StatsimVariant& v = {},
