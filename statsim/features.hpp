@@ -29,7 +29,8 @@ enum class Features : std::uint32_t {
   hull_contacts = 1u << 1,
   /// Tilted planes (`detail::is_tilted_plane`: gravity pulls along a plane that carries weight):
   /// statistical bodies roll and tumble down them at their hulls, and plain spheres meet them as
-  /// on any plane; with `WorldDef::ground_hulls`, level ground after a body's first impact too.
+  /// on any plane; with `WorldDef::ground_hulls`, level ground after a body's first impact and
+  /// slow landings too.
   /// Without it `add_plane` refuses a tilted plane, and `configure` a gravity that tilts a plane
   /// already added or ground hulls.
   slopes = 1u << 2,

@@ -303,7 +303,7 @@ class WorldCore {
     std::uint32_t* awake;
     std::uint32_t* flagged;
     std::uint32_t* rolled;
-    std::uint32_t* grounded;
+    std::uint32_t* hull_ground;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
     Impact<D>* impacts;
     std::uint32_t max_impacts;
@@ -345,12 +345,13 @@ class WorldCore {
     if (hull_planes)
       for (std::uint32_t k = 0; k < detail::bit_words(w_.body_count); ++k) {
         w_.rolled[k] = 0;
-        if (ground_hulls) w_.grounded[k] = 0;
+        if (ground_hulls) w_.hull_ground[k] = 0;
       }
     result.bodies_integrated = detail::integrate<FS>(w_, dt, [&](std::uint32_t i) {
       if constexpr (FS::slopes) {
         // `on_ground` is still last step's: `forget_contacts` clears it below.
-        if (ground_hulls && w_.bodies[i].on_ground) detail::set_bit(w_.grounded, i);
+        if (ground_hulls && (w_.bodies[i].on_ground || detail::slow_landing(w_, w_.bodies[i])))
+          detail::set_bit(w_.hull_ground, i);
         return hull_planes && detail::roll_on_slopes<FS>(w_, i, dt, impacts_, id);
       } else {
         (void)i;
@@ -407,7 +408,7 @@ class WorldCore {
            s.awake,
            s.flagged,
            s.rolled,
-           s.grounded,
+           s.hull_ground,
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
@@ -488,7 +489,7 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                          StorageBase::pair_store.data(), StorageBase::plane_store.data(),
                          StorageBase::shape_store.data(), StorageBase::awake_store.data(),
                          StorageBase::flagged_store.data(), StorageBase::rolled_store.data(),
-                         StorageBase::grounded_store.data(), MaxBodies, MaxPairs,
+                         StorageBase::hull_ground_store.data(), MaxBodies, MaxPairs,
                          MaxPlanes, MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
                          StorageBase::generation_store.data(), StorageBase::free_store.data(), StorageBase::grid,
                          StorageBase::pair_hull_store.data(), std::uint32_t(StorageBase::pair_hull_store.size()), F,

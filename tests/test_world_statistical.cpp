@@ -439,10 +439,12 @@ namespace {
 /// Drops `n` bodies of table `sig` apart onto level ground, each alone, with `WorldDef::ground_hulls`
 /// as `hulls`, and counts the steps that begin with a body on the ground and end with it awake
 /// (`on_ground`), those of them that end with its hull in the ground (the centre below the hull's
-/// support toward the ground by more than a thousandth of the bounding radius), and the
-/// statistical responses of all steps.
+/// support toward the ground by more than a thousandth of the bounding radius), those that end
+/// with it settling on the ground without a rest pose, and the statistical responses of all
+/// steps.
 template <int D, class World>
-void ground_steps(const SignatureView<D>& sig, int n, bool hulls, int& grounded, int& sunk, std::uint64_t& responses)
+void ground_steps(const SignatureView<D>& sig, int n, bool hulls, int& grounded, int& sunk, int& poseless,
+                  std::uint64_t& responses)
 {
   using Vec = typename Space<D>::Vec;
   constexpr int up = Space<D>::up_axis;
@@ -463,7 +465,7 @@ void ground_steps(const SignatureView<D>& sig, int n, bool hulls, int& grounded,
     b.orientation = statsim::random_orientation<D>(g);
     REQUIRE(w->add_body(b).ok());
   }
-  grounded = sunk = 0;
+  grounded = sunk = poseless = 0;
   responses = 0;
   std::vector<char> before(std::size_t(n), 0);
   for (int s = 0; s < 600; ++s) {
@@ -477,6 +479,7 @@ void ground_steps(const SignatureView<D>& sig, int n, bool hulls, int& grounded,
       ++grounded;
       const Scalar support = detail::support_along(sig.contact, detail::to_body(b.orientation, Vec(-Vec::Unit(up))));
       sunk += b.position[up] < support - Scalar(1e-3) * bound;
+      poseless += b.state == MotionState::settling && b.on_ground && b.rest_pose == no_rest_pose;
     }
   }
 }
@@ -486,24 +489,91 @@ TEST_CASE("ground hulls: after the first impact a body on level ground stands on
 {
   // The first impact from flight is the table's response; with `WorldDef::ground_hulls` a body
   // that was on the ground as a step began meets it with its hull (`detail::ground_hull`), as a
-  // rigid body tumbles over its edges, where its collision sphere lets its corners sink in.
+  // rigid body tumbles over its edges, where its collision sphere lets its corners sink in. Once
+  // settling (slower than the settle speed) it takes a rest pose, with the option as without.
   for (const bool hulls : {true, false}) {
     CAPTURE(hulls);
-    int grounded = 0, sunk = 0;
+    int grounded = 0, sunk = 0, poseless = 0;
     std::uint64_t responses = 0;
-    ground_steps<3, World3<32>>(tables::lshape.view(), 32, hulls, grounded, sunk, responses);
-    MESSAGE("3D: " << grounded << " steps on the ground, " << sunk << " of them sunk, " << responses << " responses");
+    ground_steps<3, World3<32>>(tables::lshape.view(), 32, hulls, grounded, sunk, poseless, responses);
+    MESSAGE("3D: " << grounded << " steps on the ground, " << sunk << " of them sunk, " << poseless
+                   << " settling without a pose, " << responses << " responses");
     CHECK(grounded > 200);
     CHECK(responses >= 32);
+    CHECK(poseless == 0);
     if (hulls) CHECK(sunk == 0);
     else CHECK(sunk > 20);  // the spheres' rule, which the option replaces
-    ground_steps<2, World2<32>>(tables::lshape2d.view(), 32, hulls, grounded, sunk, responses);
-    MESSAGE("2D: " << grounded << " steps on the ground, " << sunk << " of them sunk, " << responses << " responses");
+    ground_steps<2, World2<32>>(tables::lshape2d.view(), 32, hulls, grounded, sunk, poseless, responses);
+    MESSAGE("2D: " << grounded << " steps on the ground, " << sunk << " of them sunk, " << poseless
+                   << " settling without a pose, " << responses << " responses");
     CHECK(grounded > 200);
     CHECK(responses >= 32);
+    CHECK(poseless == 0);
     if (hulls) CHECK(sunk == 0);
     else CHECK(sunk > 20);
   }
+}
+
+namespace {
+/// Statistical responses of `n` L-shapes that fall onto level ground at random orientations,
+/// without spin or horizontal speed, each alone, their hull's lowest point `drop` m above the
+/// ground, at `speed` m/s downwards, in their first second, with `WorldDef::ground_hulls` as
+/// `hulls`. Their hulls land at sqrt(speed^2 + 2 |g| drop).
+std::uint64_t landing_responses(int n, bool hulls, Scalar drop, Scalar speed)
+{
+  WorldDef3 def;
+  def.ground_hulls = hulls;
+  auto w = std::make_unique<World3<32>>(def);
+  REQUIRE(w->construction_status() == Status::ok);
+  const ShapeId shape = w->add_shape(tables::lshape.view()).id;
+  REQUIRE(w->add_plane(Vector3::UnitZ(), 0).ok());
+  Pcg32 g(23, 5);
+  for (int i = 0; i < n; ++i) {
+    BodyDef3 b;
+    b.shape = shape;
+    b.orientation = random_orientation(g);
+    const Scalar support = detail::support_along(tables::lshape.view().contact,
+                                                 detail::to_body(b.orientation, Vector3(-Vector3::UnitZ())));
+    b.position = Vector3(Scalar(6) * Scalar(i), 0, support + drop);
+    b.linear_velocity = Vector3(0, 0, -speed);
+    REQUIRE(w->add_body(b).ok());
+  }
+  std::uint64_t responses = 0;
+  for (int s = 0; s < 60; ++s) {
+    const StepResult r = w->step(Scalar(1) / 60);
+    REQUIRE(r.ok());
+    responses += r.statistical_responses;
+  }
+  return responses;
+}
+}  // namespace
+
+TEST_CASE("ground hulls: a landing slower than the landing data measured is the hull's, a faster one the table's")
+{
+  // `detail::slow_landing`: below |v|^2 = F_1 |g| L (F_1 the landing axes' first Froude number
+  // above 0, L the signature's length) a body from flight meets level ground with its hull, as a
+  // hop's landing; above it the table's response stands.
+  const SignatureView<3> sig = tables::lshape.view();
+  REQUIRE(sig.landing.present());
+  Scalar f1 = 0;
+  for (std::uint32_t k = 0; k < sig.landing.axes[2].size && !(f1 > 0); ++k) f1 = sig.landing.axes[2].values[k];
+  REQUIRE(f1 > 0);
+  const Scalar g = 9.81f, limit2 = f1 * g * sig.length;
+  // Slow: from rest, |v|^2 = 0.5 F_1 |g| L at the ground, above the table's restitution
+  // threshold, so that without the option a landing is a statistical collision (where the
+  // collision sphere does not start on the ground: it may stand below or above the hull).
+  const Scalar slow_drop = Scalar(0.25) * limit2 / g;
+  REQUIRE(std::sqrt(2 * g * slow_drop) > 2 * g / 60);
+  // Fast: |v|^2 = 3 F_1 |g| L at the start, more at the ground.
+  const Scalar fast_speed = std::sqrt(3 * limit2);
+  const std::uint64_t slow_hulls = landing_responses(32, true, slow_drop, 0);
+  const std::uint64_t slow_spheres = landing_responses(32, false, slow_drop, 0);
+  const std::uint64_t fast_hulls = landing_responses(32, true, 0.05f, fast_speed);
+  MESSAGE("statistical responses: slow with ground hulls " << slow_hulls << ", without " << slow_spheres
+                                                           << "; fast with ground hulls " << fast_hulls);
+  CHECK(slow_hulls == 0);
+  CHECK(slow_spheres >= 24);
+  CHECK(fast_hulls >= 32);
 }
 
 TEST_CASE("ground hulls: refused without Features::slopes, the world unchanged")

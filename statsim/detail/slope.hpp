@@ -2,8 +2,8 @@
 /// @file
 /// Which contacts with planes a body meets at its hull rather than its collision sphere: a
 /// tilted plane (`is_tilted_plane`) for a statistical body with a support map (`slope_hull`),
-/// level ground after the first impact (`ground_hull`), and a settling body that other bodies
-/// hold (`hull_radius`). What happens at those contacts is
+/// level ground after the first impact and in slow landings (`ground_hull`, `slow_landing`), and
+/// a settling body that other bodies hold (`hull_radius`). What happens at those contacts is
 /// slope_contact.hpp's.
 
 #include "statsim/detail/hull.hpp"
@@ -62,8 +62,9 @@ bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>
 }
 
 /// True when body `b` meets the plane of unit normal `n` with its hull because it is level ground
-/// (it carries weight, and gravity has no part along it) that the body was on at the start of the
-/// step (`WorldData::grounded`), the body statistical with a support map and principal moments.
+/// (it carries weight, and gravity has no part along it) and the body is marked in
+/// `WorldData::hull_ground` for the step (on the ground as the step began, or landing slowly:
+/// `slow_landing`), the body statistical with a support map and principal moments.
 /// The statistical response stands for a collision as a whole: the tables give what a rigid body
 /// leaves the ground with after it, however many times its corners strike within it. A body
 /// already on the ground, though, tumbles over its edges and hops on its corners, each strike set
@@ -78,10 +79,36 @@ bool ground_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D
   if constexpr (!FS::slopes || !FS::statistical) {
     return false;
   }
-  if (!w.def.ground_hulls || !w.def.rest_conditions || !bit_set(w.grounded, std::uint32_t(&b - w.bodies))) return false;
+  if (!w.def.ground_hulls || !w.def.rest_conditions || !bit_set(w.hull_ground, std::uint32_t(&b - w.bodies))) return false;
   if (!hull_shape(w.shapes[b.shape])) return false;
   Scalar gn;
   return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
+}
+
+/// True when body `b`, statistical with landing data (`LandingView`), falls (its velocity has a
+/// part along gravity) slower than the slowest impact its landing data measured:
+/// |v|^2 < F_1 |g| L, F_1 the first Froude number above 0 on the landing axes, L the signature's
+/// length. A hop of a tumbling body ends in such a landing (from a rise of about F_1 L / 2 or
+/// less). The landing data hold what trials under gravity measured from F_1 up, and below it
+/// only the limit F = 0, where every impact stays; the response tables hold impacts at the
+/// gathering's speed, scaled. A landing that slow is the tumble going on, not an impact the table
+/// measured: with `WorldDef::ground_hulls` the body meets level ground with its hull
+/// (`ground_hull`), as one that was on it, and a hop's landing draws no fresh collision. Without
+/// landing data (tables before format 2.2, and 2D tables) it is false: bodies from flight keep the
+/// statistical response, as before.
+template <int D>
+bool slow_landing(const WorldData<D>& w, const Body<D>& b)
+{
+  const Shape<D>& s = w.shapes[b.shape];
+  const LandingView& l = s.signature.landing;
+  if (!s.statistical || !l.present() || !(b.linear_velocity.dot(w.def.gravity) > 0)) return false;
+  const AxisView& froude = l.axes[2];
+  std::uint32_t k = 0;
+  while (k < froude.size && !(froude.values[k] > 0)) ++k;
+  if (k == froude.size) return false;
+  // |v|^2 < F_1 |g| L, squared: no root of |g|^2.
+  const Scalar v2 = b.linear_velocity.squaredNorm(), limit = froude.values[k] * s.signature.length;
+  return v2 * v2 < limit * limit * w.def.gravity.squaredNorm();
 }
 
 /// True when some body may meet a plane with its hull (`rolls_on`): the world has a tilted plane
@@ -134,7 +161,7 @@ Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& pla
   // every pass, and most need neither.
   const std::uint32_t i = std::uint32_t(&b - w.bodies);
   const bool slopes = FS::slopes && w.tilted_planes;
-  const bool ground = FS::slopes && w.def.ground_hulls && bit_set(w.grounded, i);
+  const bool ground = FS::slopes && w.def.ground_hulls && bit_set(w.hull_ground, i);
   const bool hulls = FS::hull_contacts && hull_contacts_on(w) && b.state == MotionState::settling;
   if (!slopes && !ground && !hulls) return b.radius;
   if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;

@@ -59,11 +59,13 @@ struct WorldData {
   /// after the contact passes it holds the islands' marks (`WorldDef::sleep_islands`,
   /// `update_motion_states`), and the next step clears it before a substep writes it.
   std::uint32_t* rolled;
-  /// With `WorldDef::ground_hulls`, bit set of the awake bodies that were on the ground at the
-  /// start of this step (their `on_ground` before `forget_contacts` clears it): such a body meets
-  /// level ground with its hull (`ground_hull`), while a body that arrives from flight gets the
-  /// statistical response. Scratch of the step, written by `integrate`: a snapshot needs nothing.
-  std::uint32_t* grounded;
+  /// With `WorldDef::ground_hulls`, bit set of the awake bodies that meet level ground with their
+  /// hull in this step (`ground_hull`): those on the ground at its start (their `on_ground`
+  /// before `forget_contacts` clears it) and those landing slower than their table's landing data
+  /// measured (`slow_landing`); a body that arrives from flight faster gets the statistical
+  /// response. Scratch of the step, written by `integrate` from the state at the step's start: a
+  /// snapshot needs nothing.
+  std::uint32_t* hull_ground;
   std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   std::uint32_t body_count = 0, pair_count = 0, plane_count = 0, shape_count = 0;
   /// Bodies that have a sweep entry: sweep-and-prune adds the entries of newer bodies when it
