@@ -187,6 +187,7 @@ MethodResult run_statsim_once(const Compare2dOptions& o, const statsim::Signatur
   def.restitution_threshold = sig.restitution_threshold;  // as Box2D's (1 m/s)
   def.pile_rest = o.pile_rest;
   def.sleep_islands = o.sleep_islands;  // the default, hull contacts where the table has body-body data, kept
+  def.ground_hulls = o.ground_hulls;
   auto world = std::make_unique<StatWorld>(def);
   if (world->construction_status() != statsim::Status::ok) {
     throw std::runtime_error("statsim world rejected its parameters");
@@ -518,6 +519,7 @@ std::string compare2d_table(const Compare2dResult& r)
        ") of " + std::to_string(o.steps) + " steps of " + fmt("%.5g", o.dt) +
        " s; step times: least of " + std::to_string(o.repeat) + " identical runs, mean over the drops" +
        (o.pile_rest ? "; statsim with pile_rest" : "") + (o.sleep_islands ? "" : "; statsim without sleep_islands") +
+       (o.ground_hulls ? "; statsim with ground_hulls" : "") +
        (o.box2d_substeps > 1 ? "; Box2D in " + std::to_string(o.box2d_substeps) + " substeps per step" : "") + "\n";
   t += "box2d_b: Box2D on seeds " + std::to_string(o.seed + static_cast<std::uint64_t>(o.drops)) + ".." +
        std::to_string(o.seed + static_cast<std::uint64_t>(2 * o.drops) - 1) +
@@ -645,6 +647,8 @@ void register_compare2d_command(CLI::App& app)
   c->add_flag("!--no-sleep-islands", cmd->options.sleep_islands,
               "statsim: each body falls asleep on its own (WorldDef::sleep_islands off; the default: touching "
               "bodies fall asleep together, once all are still)");
+  c->add_flag("--ground-hulls", cmd->options.ground_hulls,
+              "statsim: bodies meet level ground with their hull after the first impact (WorldDef::ground_hulls)");
   c->add_option("--history-every", cmd->options.history_every,
                 "Also show the highest centre and the bodies awake every this many seconds (mean over the drops)")
       ->check(CLI::NonNegativeNumber)

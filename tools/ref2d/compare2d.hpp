@@ -30,6 +30,7 @@ struct Compare2dOptions {
   int drops = 10;
   bool pile_rest = false;        ///< statsim's WorldDef::pile_rest
   bool sleep_islands = true;     ///< statsim's WorldDef::sleep_islands
+  bool ground_hulls = false;     ///< statsim's WorldDef::ground_hulls
   /// Box2D takes this many steps of dt / box2d_substeps for each step of dt (its convergence:
   /// tools/ref2d/convergence2d.py); statsim always steps dt.
   int box2d_substeps = 1;

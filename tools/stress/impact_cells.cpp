@@ -76,7 +76,7 @@ void Matrix::fast_impact()
                                          double(tables::square2d.material.restitution),
                                          double(tables::square2d.material.friction));
       else
-        sim = std::make_unique<StatsimSim2>(states2, contacts());
+        sim = std::make_unique<StatsimSim2>(states2, contacts(), ground_hulls());
       double pen = 0;
       std::vector<bool> through(states2.size(), false);
       for (int k = 0; k < steps; ++k) {

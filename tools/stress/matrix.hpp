@@ -73,8 +73,10 @@ public:
   Setup3 with_contacts(Setup3 setup) const
   {
     setup.body_contacts = contacts();
+    setup.ground_hulls = ground_hulls();
     return setup;
   }
+  bool ground_hulls() const { return opt_.ground_hulls; }
   BodyContacts contacts() const
   {
     return opt_.hull_contacts ? BodyContacts::automatic : BodyContacts::collision_spheres;

@@ -306,6 +306,7 @@ void Matrix::spawn_remove()
   const long steps = std::lround(hours * 3600 / dt);
   WorldDef3 def;
   def.body_contacts = contacts();
+  def.ground_hulls = ground_hulls();
   auto w = std::make_unique<W>(def);
   const Added<ShapeId> shape = w->add_shape(tables::bunny.view());
   const Scalar r = Scalar(R()), wall = 4 * r;

@@ -174,7 +174,7 @@ void Matrix::slopes()
                                          double(tables::square2d.material.restitution),
                                          double(tables::square2d.material.friction), a);
       else
-        sim = std::make_unique<StatsimSim2>(states2, contacts(), a);
+        sim = std::make_unique<StatsimSim2>(states2, contacts(), ground_hulls(), a);
       return run_slope(
           states2.size(), frame, after, r2,
           [&]() {

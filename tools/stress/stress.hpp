@@ -22,6 +22,8 @@ struct StressOptions {
   /// statsim's worlds with the library's default body contacts (`BodyContacts::automatic`: hulls
   /// where the tables have body-body data); false: the paper's collision spheres.
   bool hull_contacts = true;
+  /// statsim's worlds with `WorldDef::ground_hulls` (off: the library's default).
+  bool ground_hulls = false;
   bool progress = true;
 };
 

@@ -60,6 +60,8 @@ void register_stress_commands(CLI::App& app)
                   "body-body data) or spheres (the paper's collision spheres)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"hulls", true}, {"spheres", false}}))
       ->default_str("hulls");
+  cmd->add_flag("--ground-hulls", opts->ground_hulls,
+                "statsim: bodies meet level ground with their hull after the first impact (WorldDef::ground_hulls)");
   cmd->callback([opts, json]() {
     const std::vector<StressCell> cells = run_stress(*opts);
     std::cout << stress_markdown(cells);

@@ -60,6 +60,8 @@ struct Setup3 {
   bool particle = false;
   /// statsim: where bodies touch (`StressOptions::hull_contacts`).
   BodyContacts body_contacts = BodyContacts::automatic;
+  /// statsim: `WorldDef::ground_hulls` (`StressOptions::ground_hulls`).
+  bool ground_hulls = false;
   /// statsim: the table; null: the bunny's. Bullet takes the `Body3` it is given.
   const SignatureView<3>* signature = nullptr;
   /// Body i has the shape's mass (and inertia) times `mass_scale[i]`; empty: all 1.
@@ -81,6 +83,7 @@ public:
     WorldDef3 def;
     def.gravity = setup.gravity.cast<Scalar>();
     def.body_contacts = setup.body_contacts;
+    def.ground_hulls = setup.ground_hulls;
     world_ = std::make_unique<WorldT>(def);
     Added<ShapeId> shape;
     if (setup.particle) {
@@ -299,10 +302,11 @@ private:
 class StatsimSim2 final : public Sim2 {
 public:
   /// The ground's normal is (0, 1), or with `slope` (rad) (sin, cos): falling along +x.
-  StatsimSim2(const std::vector<scenes::BodyState2>& states, BodyContacts contacts, double slope = 0)
+  StatsimSim2(const std::vector<scenes::BodyState2>& states, BodyContacts contacts, bool ground_hulls, double slope = 0)
   {
     WorldDef2 def;
     def.body_contacts = contacts;
+    def.ground_hulls = ground_hulls;
     world_ = std::make_unique<World2<256, 4, 256 * 16, 2>>(def);
     const SignatureView<2> sig = tables::square2d.view();
     const auto shape = world_->add_shape(sig);
