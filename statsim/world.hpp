@@ -304,6 +304,7 @@ class WorldCore {
     std::uint32_t* flagged;
     std::uint32_t* rolled;
     std::uint32_t* hull_ground;
+    std::uint32_t* paired;
     std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
     Impact<D>* impacts;
     std::uint32_t max_impacts;
@@ -362,6 +363,7 @@ class WorldCore {
     // Before the broad phase, which replaces last step's pairs (it does not read the flags).
     detail::forget_contacts(w_);
     detail::find_pairs<FS>(w_, result);
+    if constexpr (FS::statistical) detail::mark_paired(w_);
     detail::record_impacts<FS>(w_, impacts_, id);
     result.impacts_found = impacts_.found;
     if (impacts_.found > impacts_.count) {
@@ -409,6 +411,7 @@ class WorldCore {
            s.flagged,
            s.rolled,
            s.hull_ground,
+           s.paired,
            s.max_bodies,
            s.max_pairs,
            s.max_planes,
@@ -489,7 +492,7 @@ class World : private detail::WorldStorage<D, MaxBodies, MaxPlanes, MaxPairs, Ma
                          StorageBase::pair_store.data(), StorageBase::plane_store.data(),
                          StorageBase::shape_store.data(), StorageBase::awake_store.data(),
                          StorageBase::flagged_store.data(), StorageBase::rolled_store.data(),
-                         StorageBase::hull_ground_store.data(), MaxBodies, MaxPairs,
+                         StorageBase::hull_ground_store.data(), StorageBase::paired_store.data(), MaxBodies, MaxPairs,
                          MaxPlanes, MaxShapes, StorageBase::impact_store.data(), MaxImpacts,
                          StorageBase::generation_store.data(), StorageBase::free_store.data(), StorageBase::grid,
                          StorageBase::pair_hull_store.data(), std::uint32_t(StorageBase::pair_hull_store.size()), F,

@@ -313,6 +313,47 @@ TEST_CASE("cubes with the gathered box table rest face down at half the side")
   CHECK(used >= 5);  // random drops reach (nearly) every face
 }
 
+// A box tilted 30 degrees about y onto the edge at body (+a, -a) and let go there, alone or
+// with a second box 0.3 m away (near enough to be a candidate pair, too far to touch): the
+// horizontal distance its centre moves (m) by the time it sleeps, and its last rest pose.
+static Scalar tip_from_edge(bool neighbour, std::uint8_t& pose)
+{
+  const SignatureView<3> sig = tables::box.view();
+  auto w = std::make_unique<World3<4>>();
+  const ShapeId shape = w->add_shape(sig).id;
+  REQUIRE(w->add_plane(Vector3::UnitZ(), 0).ok());
+  BodyDef3 d;
+  d.shape = shape;
+  d.orientation = Quaternion(Eigen::AngleAxisf(0.5236f, Vector3::UnitY()));
+  d.position = Vector3(0, 0, 0.14f);  // the edge stands 0.137 m below the centre
+  const BodyId tipping = w->add_body(d).id;
+  if (neighbour) {
+    BodyDef3 n;
+    n.shape = shape;
+    n.position = Vector3(0, 0.3f, 0.1f);
+    REQUIRE(w->add_body(n).ok());
+  }
+  for (int k = 0; k < 240; ++k) w->step(1.0f / 60);
+  const Body3& b = w->body(tipping);
+  CHECK(b.state == MotionState::asleep);
+  pose = b.rest_pose;
+  return b.position.x();
+}
+
+TEST_CASE("a lone body's rest turn pivots about the edge it stands on; near another body about its centre")
+{
+  // Falling flat about that edge (at x = a (cos 30 - sin 30) = +0.037 m) takes the centre to a
+  // = 0.1 m on the other side of it, x = -0.063 m; a turn about the centre leaves it at x = 0.
+  std::uint8_t alone_pose = no_rest_pose, near_pose = no_rest_pose;
+  const Scalar alone = tip_from_edge(false, alone_pose);
+  const Scalar near = tip_from_edge(true, near_pose);
+  MESSAGE("centre moved along x: alone " << alone << " m, near another body " << near << " m");
+  CHECK(alone_pose == near_pose);  // the same face down either way
+  CHECK(alone < -0.04f);
+  CHECK(alone > -0.08f);
+  CHECK(std::fabs(near) < 0.01f);
+}
+
 TEST_CASE("a pile of 600 bunnies holds - sphere overlaps under 10% of the radius and none below the ground")
 {
   // The paper's collision spheres between bodies: with hull contacts bodies overlap at their

@@ -106,6 +106,30 @@ void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, cons
                                def.restitution_threshold);
   } else if (ground_contact && b.rest_pose != no_rest_pose) {
     if (!(v.dot(n) < 0)) return;
+    // A rigid body tipping onto a face turns about the edge or corner it stands on, not about
+    // its centre, and its centre moves along the ground as it falls: from above the edge to
+    // above the face's middle, up to half its width. So the turn of a body with no other body
+    // near (`WorldData::paired`) pivots about p, the hull's support point along -n (the middle
+    // of the edge or face it stands on): its centre's velocity along the plane is that of the
+    // point p plus (w x (c - p))_t. Friction acts on p's velocity, the slip, found with the
+    // spin the body came with; the centre then takes the new turn's part. A body turning
+    // without slip moves exactly with its turn, and one that has reached its pose (w = 0)
+    // slides to a stop as before. Near other bodies the turn stays about the centre: a pivot
+    // pushes the neighbours it turns into, and the bottom layers of a bin pack far too densely
+    // (tools/fidelity/LOG.md). It pivots only while its pose is the one it leans towards, the
+    // nearest by angle: a pose the rest conditions chose against that (a basin's bias,
+    // `rest_basin_biases`, which also moves a body placed exactly in a pose that is not its
+    // basin's) is the statistics' and has no tip to copy, and the turn stays about the centre.
+    // A table without a support map turns about the centre.
+    const ContactView<D>& hull = shape.signature.contact;
+    const bool pivots = hull.present() && !bit_set(w.paired, std::uint32_t(&b - w.bodies)) &&
+                        nearest_rest_pose<D>(shape.signature, b.orientation, n) == b.rest_pose;
+    Vec arm = Vec::Zero();
+    const auto along_plane = [&n](const Vec& x) { return Vec(x - n * x.dot(n)); };
+    if (pivots) {
+      arm = -to_world(b.orientation, support_point<D>(hull, to_body(b.orientation, Vec(-n))));
+      v -= along_plane(cross(b.angular_velocity, arm));
+    }
     v = point_particle_velocity<D>(v, n, shape.material, def.restitution_threshold);
     const auto offset = rest_turn(b.orientation, shape.signature.rest.normal(b.rest_pose), n, Scalar(1));
     if (b.slow_time < 0) {
@@ -122,6 +146,7 @@ void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, cons
     const Scalar cap = def.settle_speed / shape.bounding_radius;
     const Scalar spin2 = squared_norm(b.angular_velocity);
     if (spin2 > cap * cap) b.angular_velocity = b.angular_velocity * (cap / std::sqrt(spin2));
+    if (pivots) v += along_plane(cross(b.angular_velocity, arm));
   } else {
     Pcg32 rng = rng_of(w, b);
     // Against a plane, the part of gravity pressing the body onto it decides how often the
@@ -318,6 +343,18 @@ void forget_contacts(WorldData<D>& w)
     forget(w.pairs[k].b);
   }
   for (std::uint32_t k = 0; k < bit_words(w.body_count); ++k) w.flagged[k] = 0;
+}
+
+/// Marks in `WorldData::paired` the bodies of this step's candidate pairs (the broad phase's,
+/// before the impact pass compacts them).
+template <int D>
+void mark_paired(WorldData<D>& w)
+{
+  for (std::uint32_t k = 0; k < bit_words(w.body_count); ++k) w.paired[k] = 0;
+  for (std::uint32_t k = 0; k < w.pair_count; ++k) {
+    set_bit(w.paired, w.pairs[k].a);
+    set_bit(w.paired, w.pairs[k].b);
+  }
 }
 
 /// The plane contacts of a support pass (and of the shock pass): inelastic particle responses.

@@ -66,6 +66,10 @@ struct WorldData {
   /// response. Scratch of the step, written by `integrate` from the state at the step's start: a
   /// snapshot needs nothing.
   std::uint32_t* hull_ground;
+  /// Bit set of the bodies in at least one of this step's candidate pairs (`mark_paired`, after
+  /// the broad phase): a body with none has no other body near it, and its rest turn pivots
+  /// about the point it stands on (`respond_alone`). Scratch of the step: a snapshot needs nothing.
+  std::uint32_t* paired;
   std::uint32_t max_bodies, max_pairs, max_planes, max_shapes;
   std::uint32_t body_count = 0, pair_count = 0, plane_count = 0, shape_count = 0;
   /// Bodies that have a sweep entry: sweep-and-prune adds the entries of newer bodies when it

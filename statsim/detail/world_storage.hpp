@@ -34,6 +34,7 @@ struct WorldStorage {
   std::array<std::uint32_t, bit_words(MaxBodies)> flagged_store;
   std::array<std::uint32_t, bit_words(MaxBodies)> rolled_store;
   std::array<std::uint32_t, bit_words(MaxBodies)> hull_ground_store;
+  std::array<std::uint32_t, bit_words(MaxBodies)> paired_store;
   std::array<Impact<D>, MaxImpacts> impact_store;
   std::array<std::uint16_t, MaxBodies> generation_store;
   std::array<std::uint32_t, bit_words(MaxBodies)> free_store;
