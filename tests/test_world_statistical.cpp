@@ -333,7 +333,7 @@ static Scalar tip_from_edge(bool neighbour, std::uint8_t& pose)
     n.position = Vector3(0, 0.3f, 0.1f);
     REQUIRE(w->add_body(n).ok());
   }
-  for (int k = 0; k < 240; ++k) w->step(1.0f / 60);
+  for (int k = 0; k < 240; ++k) REQUIRE(w->step(1.0f / 60).ok());
   const Body3& b = w->body(tipping);
   CHECK(b.state == MotionState::asleep);
   pose = b.rest_pose;
