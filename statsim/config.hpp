@@ -91,10 +91,10 @@
 #define STATSIM_TABLE_FORMAT_VERSION 2
 /// Additions to format 2 that older tables can do without: 1 adds the mesh frame and the
 /// body-body data (`ContactView`), 2 the landing data (`LandingView`), 3 the settling data
-/// (`SettleView`), 4 the spin measure (`ResponseSpin`). A table of an older minor format still
-/// loads; one that needs a newer one checks this with `#if` and stops with a message on a
-/// runtime that lacks it.
-#define STATSIM_TABLE_FORMAT_MINOR 4
+/// (`SettleView`), 4 the spin measure (`ResponseSpin`), 5 its value `ResponseSpin::energy`. A
+/// table of an older minor format still loads; one that needs a newer one checks this with `#if`
+/// and stops with a message on a runtime that lacks it.
+#define STATSIM_TABLE_FORMAT_MINOR 5
 
 namespace statsim {
 

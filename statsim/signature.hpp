@@ -232,6 +232,14 @@ enum class ResponseSpin : std::uint8_t {
   /// draw is the rotational kinetic energy over 1/2 m |V-|^2 whatever the orientation; the
   /// runtime takes W+ = R diag(sqrt(m / I_k)) R^T (draw) |V-| with the body's own R. 3D only.
   gyration,
+  /// As `gyration`, and the table's spin-ratio coordinate measures the incoming spin by its
+  /// energy too: |K W-| L / (k |V-|), k = sqrt((I_1 + I_2 + I_3) / 3m) the radius of gyration
+  /// averaged over all axes (the gathering's trials are made at that ratio). With `gyration` a
+  /// rod rolling fast about its long axis, cheap in energy, is looked up at a high ratio whose
+  /// trials spun mostly about short axes, with up to (I_max / I_min) times the energy, and
+  /// bounce as those do. For a body whose three moments are equal it is `gyration`. 3D only
+  /// (format 2.5).
+  energy,
 };
 
 /// Everything the runtime knows about a shape.
@@ -246,7 +254,8 @@ struct SignatureView {
   Material material{};         ///< restitution and friction the reference used, and V_particle+ uses
   Scalar restitution_threshold = 0;  ///< m/s, of V_particle+ (as the world's)
   ResponseLayout layout = ResponseLayout::scaled;
-  ResponseSpin spin = ResponseSpin::length;  ///< of the response table's w components (format 2.4)
+  /// Of the response table's w components (format 2.4) and its spin-ratio coordinate (2.5)
+  ResponseSpin spin = ResponseSpin::length;
   HeightTableView height;
   ResponseTableView response;  ///< components: 2D w, dv_x, dv_y; 3D w_xyz, dv_xyz
   RestPosesView<D> rest;

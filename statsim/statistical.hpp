@@ -134,6 +134,7 @@ inline Scalar landing_probability(const LandingView& landing, Scalar cos_theta, 
 /// `v` is the velocity relative to the collision plane; it must approach it (v.n < 0).
 template <int D>
 std::uint32_t response_coordinates(const SignatureView<D>& sig, const ContactFrame<D>& frame,
+                                   const typename Space<D>::Rot& orientation,
                                    const typename Space<D>::Vec& n, const typename Space<D>::Vec& v,
                                    const typename Space<D>::Spin& w, Scalar* x)
 {
@@ -146,8 +147,19 @@ std::uint32_t response_coordinates(const SignatureView<D>& sig, const ContactFra
     const Scalar wn = w.norm();
     x[k++] = wn > 0 ? v.dot(w) / (speed * wn) : Scalar(0);
     if (sig.layout == ResponseLayout::with_speed) x[k++] = speed;
-    x[k++] = wn * sig.length / speed;
+    Scalar spin = wn;
+    if (sig.spin == ResponseSpin::energy) {
+      // |K W-| / k: |K W-|^2 = W^T (I / m) W is twice the rotational energy per unit mass, and
+      // k^2 = tr(I / m) / 3 its mean over spin axes drawn uniformly, as the trials draw them.
+      const Vector3 wb = orientation.conjugate() * w;
+      const Scalar kw2 = sig.unit_inertia[0] * wb.x() * wb.x() + sig.unit_inertia[1] * wb.y() * wb.y() +
+                         sig.unit_inertia[2] * wb.z() * wb.z();
+      const Scalar k2 = (sig.unit_inertia[0] + sig.unit_inertia[1] + sig.unit_inertia[2]) / 3;
+      spin = std::sqrt(kw2 / k2);
+    }
+    x[k++] = spin * sig.length / speed;
   } else {
+    (void)orientation;
     x[k++] = frame.mirror * w * sig.length / speed;
     if (sig.layout == ResponseLayout::with_speed) x[k++] = speed;
   }
@@ -228,7 +240,7 @@ inline void sample_response(const ResponseTableView& table, const Scalar* x, Pcg
 /// the plane (to the other body, for body-body contacts), `w` its spin; both are replaced.
 /// `orientation` (body to world) is needed for the energy guard, which scales the sampled
 /// response down when it would leave more kinetic energy than the body brought to the contact,
-/// and for a table whose spin is measured by `ResponseSpin::gyration`.
+/// and for a table whose spin is measured by `ResponseSpin::gyration` or `energy`.
 /// The normal part of the new velocity is kept non-negative: a sphere that still approached the
 /// plane would collide again at once.
 /// `gravity` (m/s^2) is the part of gravity that presses the body onto the plane, for a contact
@@ -252,7 +264,7 @@ ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename
   const ContactFrame<D> frame = contact_frame(n, v, w);
 
   Scalar x[max_response_axes];
-  response_coordinates<D>(sig, frame, n, v, w, x);
+  response_coordinates<D>(sig, frame, orientation, n, v, w, x);
   // Landing data: one draw u before the response; p = the table's probability here. u < p keeps
   // the body on the plane; u < -p draws again a response that would stay (rise below hop L).
   const bool landing = sig.landing.present() && gravity > 0;
@@ -278,7 +290,7 @@ ResponseOutcome statistical_response(const SignatureView<D>& sig, const typename
     Vec offset;
     if constexpr (D == 3) {
       const Vector3 drawn = frame.basis * Vector3(sample[0], sample[1], sample[2]);
-      if (sig.spin == ResponseSpin::gyration) {
+      if (sig.spin != ResponseSpin::length) {
         // W+ = R diag(sqrt(m / I_k)) R^T (draw) |V-|: the draw's rotational energy, 1/2 |draw|^2
         // |V-|^2 per unit mass, whichever way the body is turned.
         Vector3 body = orientation.conjugate() * drawn;

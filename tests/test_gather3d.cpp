@@ -922,7 +922,7 @@ TEST_CASE("gather3d: a response trial's spin by gyration carries its rotational 
   const double L = m.bounding_radius, speed = 2.0;
   for (std::uint64_t i = 0; i < 6; ++i) {
     CAPTURE(i);
-    const ResponseTrial t = response_trial(ref, o, 0.7, 0.5, speed, 2.0, kResponseStream, i);
+    const ResponseTrial t = response_trial(ref, o, 0.7, 0.5, speed, 2.0, kResponseStream, i, false);
     const Eigen::Vector3d w = Eigen::Vector3d(t.value[0], t.value[1], t.value[2]) * (speed / L);
     const Eigen::Vector3d b = t.departure.orientation.conjugate() * w;
     const double energy = 0.5 * (m.unit_inertia.x() * b.x() * b.x() + m.unit_inertia.y() * b.y() * b.y() +
@@ -932,6 +932,48 @@ TEST_CASE("gather3d: a response trial's spin by gyration carries its rotational 
     for (int c = 3; c < 6; ++c) CHECK(t.gyration[c] == t.value[c]);
     CHECK((t.contact.velocity - speed * Eigen::Vector3d(std::sqrt(1 - 0.49), 0, -0.7)).norm() < 1e-9);
   }
+}
+
+TEST_CASE("gather3d: a response trial by energy meets the ground at its cell's spin ratio by energy")
+{
+  GatherOptions o;
+  o.box_size = {0.05, 0.1, 0.2};
+  const ShapeModel m = build_model(o);
+  const Reference ref(m, o.reference);
+  const double L = m.bounding_radius, speed = 2.0, ratio = 2.0, k = std::sqrt(m.unit_inertia.sum() / 3);
+  // |K W| L / (k |V-|), K at the body's orientation: a free flight keeps the rotational energy,
+  // so it is the same at the first contact as at the start.
+  const auto by_energy = [&](const RigidState& s) {
+    const Eigen::Vector3d b = s.orientation.conjugate() * s.spin;
+    return std::sqrt(m.unit_inertia.dot(b.cwiseProduct(b))) * L / (k * speed);
+  };
+  for (std::uint64_t i = 0; i < 6; ++i) {
+    CAPTURE(i);
+    const ResponseTrial e = response_trial(ref, o, 0.7, 0.5, speed, ratio, kResponseStream, i, true);
+    const ResponseTrial l = response_trial(ref, o, 0.7, 0.5, speed, ratio, kResponseStream, i, false);
+    CHECK(by_energy(e.contact) == doctest::Approx(ratio).epsilon(1e-9));
+    CHECK(e.contact.velocity.isApprox(l.contact.velocity, 1e-12));
+  }
+  // The spin itself: by length |W| L / |V-| is the ratio about any axis; by energy the same axis,
+  // longer about the body's long axis (the least moment) than about its shortest (the largest), by
+  // sqrt(I_max / I_min) = sqrt((0.1^2 + 0.2^2) / (0.05^2 + 0.1^2)) = 2.
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  Eigen::Index least = 0, largest = 0;
+  m.unit_inertia.minCoeff(&least);
+  m.unit_inertia.maxCoeff(&largest);
+  const Eigen::Vector3d long_axis = q * Eigen::Vector3d::Unit(least), short_axis = q * Eigen::Vector3d::Unit(largest);
+  for (const Eigen::Vector3d& axis : {long_axis, short_axis}) {
+    const Eigen::Vector3d wl = trial_spin(m, q, axis, ratio, speed, false), we = trial_spin(m, q, axis, ratio, speed, true);
+    CHECK(wl.norm() * L / speed == doctest::Approx(ratio).epsilon(1e-12));
+    CHECK(wl.normalized().isApprox(axis, 1e-12));
+    CHECK(we.normalized().isApprox(axis, 1e-12));
+    RigidState s;
+    s.orientation = q;
+    s.spin = we;
+    CHECK(by_energy(s) == doctest::Approx(ratio).epsilon(1e-12));
+  }
+  CHECK(trial_spin(m, q, long_axis, ratio, speed, true).norm() ==
+        doctest::Approx(2 * trial_spin(m, q, short_axis, ratio, speed, true).norm()).epsilon(1e-12));
 }
 
 TEST_CASE("gather3d: a table of format 2.4 with the spin by gyration whose header compiles and whose JSON loads with it")
@@ -967,7 +1009,7 @@ TEST_CASE("gather3d: a table of format 2.4 with the spin by gyration whose heade
   nlohmann::json bad = j;
   bad["response"]["spin"] = "momentum";
   CHECK_THROWS_WITH_AS(parse_signature_json(bad.dump(), "x.json"),
-                       doctest::Contains("x.json: field 'response.spin' is neither"), std::runtime_error);
+                       doctest::Contains("x.json: field 'response.spin' is not"), std::runtime_error);
 
   // The default chooses, and reports its test: gyration only below length's distance by the margin.
   std::vector<std::string> chosen = thin_box();
@@ -982,6 +1024,7 @@ TEST_CASE("gather3d: a table of format 2.4 with the spin by gyration whose heade
   CHECK(test["critical"].get<double>() == doctest::Approx(1.358 * std::sqrt(2.0 / n)));
   const bool gyration = test["ks_gyration"].get<double>() < test["ks_length"].get<double>() - test["critical"].get<double>();
   CHECK(a["response"].contains("spin") == gyration);
+  if (gyration) CHECK(a["response"]["spin"] == "energy");  // where gyration wins, auto takes energy
   // --response-spin length neither tests nor names the measure: the table of format 2.2.
   std::vector<std::string> plain = tiny_args();
   plain.insert(plain.end(), {"--landing-trials", "2", "--landing-froude", "0,16", "--response-spin", "length",
@@ -994,6 +1037,26 @@ TEST_CASE("gather3d: a table of format 2.4 with the spin by gyration whose heade
 
   // Gyration without the landing data it follows in a table is refused before any work.
   check_refused(dir, {"--response-spin", "gyration", "--no-landing"}, "--response-spin gyration needs the landing data");
+  check_refused(dir, {"--response-spin", "energy", "--no-landing"}, "--response-spin energy needs the landing data");
+
+  // By energy (format 2.5): the trials made at ratios by energy, so the means differ from the
+  // table by gyration of the same seed; no test is run.
+  std::vector<std::string> energy = thin_box();
+  energy.insert(energy.end(), {"--landing-trials", "2", "--landing-froude", "0,16", "--response-spin", "energy",
+                               "--name", "t_energy", "--out", dir.file("t_energy.hpp"), "--json", dir.file("e.json")});
+  REQUIRE(gather_cli(energy) == 0);
+  const std::string etext = read_file(dir.file("t_energy.hpp"));
+  const nlohmann::json e = nlohmann::json::parse(read_file(dir.file("e.json")));
+  CHECK(etext.find("#if !defined(STATSIM_TABLE_FORMAT_MINOR) || STATSIM_TABLE_FORMAT_MINOR < 5\n#error ") !=
+        std::string::npos);
+  CHECK(etext.find("needs table format 2.5 (spin by energy): update statsim, or regenerate the table with "
+                   "--response-spin gyration") != std::string::npos);
+  CHECK(etext.find("    {},  // no settling data\n    statsim::ResponseSpin::energy,") != std::string::npos);
+  CHECK(e["response"]["spin"] == "energy");
+  CHECK_FALSE(e["response"].contains("spin_test"));
+  CHECK(e["response"]["mean"] != j["response"]["mean"]);
+  CHECK(load_signature_json(dir.file("e.json")).view().spin == statsim::ResponseSpin::energy);
 
   check_compiles_and_adds(dir, "t_spin.hpp", "t_spin", "v.spin == statsim::ResponseSpin::gyration");
+  check_compiles_and_adds(dir, "t_energy.hpp", "t_energy", "v.spin == statsim::ResponseSpin::energy");
 }

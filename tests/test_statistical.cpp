@@ -115,7 +115,7 @@ TEST_CASE("3D frame transforms: sampled responses rotated back match the table c
     const Vector3 w = (v.normalized() * 0.6f + y * 0.8f) * (1.0f * speed / view.length);  // cos phi 0.6, s = 1
     Scalar coords[4];
     const ContactFrame<3> f = contact_frame(n, v, w);
-    REQUIRE(response_coordinates<3>(view, f, n, v, w, coords) == 3);
+    REQUIRE(response_coordinates<3>(view, f, Quaternion::Identity(), n, v, w, coords) == 3);
     CHECK(coords[0] == doctest::Approx(0.5));
     CHECK(coords[1] == doctest::Approx(0.6));
     CHECK(coords[2] == doctest::Approx(1.0));
@@ -166,7 +166,7 @@ TEST_CASE("spin by gyration: a draw's rotational energy does not depend on how t
   const Scalar speed = v0.norm();
   Scalar coords[4];
   const ContactFrame<3> frame = contact_frame(n, v0, w0);
-  response_coordinates<3>(view, frame, n, v0, w0, coords);
+  response_coordinates<3>(view, frame, Quaternion::Identity(), n, v0, w0, coords);
   Scalar mean[6], sd[6];
   view.response.lookup(coords, mean, sd);
   const Vector3 drawn = frame.basis * Vector3(mean[0], mean[1], mean[2]);
@@ -202,6 +202,55 @@ TEST_CASE("spin by gyration: a draw's rotational energy does not depend on how t
   CHECK(high > 3 * low);
 }
 
+TEST_CASE("spin by energy: the table is looked up at the incoming spin's energy, by the body's own axes")
+{
+  // The thin body of the test above: about its long axis (body x) a spin has 1/50 of the energy
+  // it has about a short one.
+  Sig3 sig = make_sig3();
+  sig.unit_inertia = {0.002f, 0.1f, 0.1f};
+  Sig3 by_gyration = sig, by_length = sig;
+  sig.spin = ResponseSpin::energy;
+  by_gyration.spin = ResponseSpin::gyration;
+  const SignatureView<3> view = sig.view(), gyration_view = by_gyration.view(), length_view = by_length.view();
+  const Vector3 n(0, 0, 1), v(1, 0, -std::sqrt(3.0f));  // |V-| = 2 m/s
+  const Scalar speed = v.norm(), k = std::sqrt((0.002f + 0.1f + 0.1f) / 3), omega = 4;
+  const Scalar along_long = omega * std::sqrt(0.002f) / k * view.length / speed;
+  const Scalar along_short = omega * std::sqrt(0.1f) / k * view.length / speed;
+  // The body turned a quarter about z: its long axis lies along world y.
+  const Quaternion quarter(Eigen::AngleAxisf(Scalar(1.5707963), Vector3::UnitZ()));
+  const struct {
+    Quaternion q;
+    Vector3 w;
+    Scalar expected;
+  } cases[] = {{Quaternion::Identity(), Vector3(omega, 0, 0), along_long},
+               {Quaternion::Identity(), Vector3(0, omega, 0), along_short},
+               {quarter, Vector3(0, omega, 0), along_long},
+               {quarter, Vector3(omega, 0, 0), along_short}};
+  for (const auto& c : cases) {
+    CAPTURE(c.expected);
+    const ContactFrame<3> frame = contact_frame(n, v, c.w);
+    Scalar x[4], xg[4], xl[4];
+    REQUIRE(response_coordinates<3>(view, frame, c.q, n, v, c.w, x) == 3);
+    response_coordinates<3>(gyration_view, frame, c.q, n, v, c.w, xg);
+    response_coordinates<3>(length_view, frame, c.q, n, v, c.w, xl);
+    CHECK(x[2] == doctest::Approx(c.expected).epsilon(1e-5));
+    // Tables by gyration (format 2.4) and by length are looked up as before: |W-| L / |V-|.
+    CHECK(xg[2] == doctest::Approx(omega * view.length / speed).epsilon(1e-6));
+    CHECK(xl[2] == xg[2]);
+    CHECK(x[0] == xg[0]);
+    CHECK(x[1] == xg[1]);
+  }
+  // A body with three equal moments: energy and length give the same ratio.
+  Sig3 round = make_sig3();
+  round.unit_inertia = {0.05f, 0.05f, 0.05f};
+  round.spin = ResponseSpin::energy;
+  const Vector3 w(1, 2, 3);
+  Scalar x[4], xl[4];
+  response_coordinates<3>(round.view(), contact_frame(n, v, w), quarter, n, v, w, x);
+  response_coordinates<3>(length_view, contact_frame(n, v, w), quarter, n, v, w, xl);
+  CHECK(x[2] == doctest::Approx(xl[2]).epsilon(1e-6));
+}
+
 TEST_CASE("spin by gyration: add_shape refuses it in 2D, without every moment, or as an unknown value")
 {
   const auto refused = [](auto& world, const auto& v) {
@@ -218,7 +267,11 @@ TEST_CASE("spin by gyration: add_shape refuses it in 2D, without every moment, o
   v.unit_inertia[1] = Scalar(1e-9) * v.length * v.length;  // a radius of gyration that vanishes
   refused(*w3, v);
   v = sig.view();
-  v.spin = static_cast<ResponseSpin>(2);
+  v.spin = static_cast<ResponseSpin>(3);
+  refused(*w3, v);
+  v = sig.view();
+  v.spin = ResponseSpin::energy;
+  v.unit_inertia[2] = 0;  // `energy` needs every moment as well
   refused(*w3, v);
   CHECK(w3->add_shape(sig.view()).ok());
   // The measure is part of the table: a shape by gyration hashes apart from the same by length.
@@ -228,6 +281,8 @@ TEST_CASE("spin by gyration: add_shape refuses it in 2D, without every moment, o
   auto w2 = std::make_unique<World2<4>>();
   SignatureView<2> v2 = testing::square2d_synthetic.view();
   v2.spin = ResponseSpin::gyration;
+  refused(*w2, v2);
+  v2.spin = ResponseSpin::energy;
   refused(*w2, v2);
   CHECK(w2->add_shape(testing::square2d_synthetic.view()).ok());
 }

@@ -93,7 +93,9 @@ Status check_signature_layout(const SignatureView<D>& sig)
   const std::uint32_t expected_axes = (D == 3 ? 3u : 2u) + (sig.layout == ResponseLayout::with_speed ? 1u : 0u);
   if (r.axis_count != expected_axes || r.components != (D == 3 ? 6u : 3u)) return Status::invalid_shape;
   // A 2D spin is a scalar: its energy never depends on the orientation, so only `length` exists.
-  if (sig.spin != ResponseSpin::length && !(D == 3 && sig.spin == ResponseSpin::gyration)) return Status::invalid_shape;
+  if (sig.spin != ResponseSpin::length &&
+      !(D == 3 && (sig.spin == ResponseSpin::gyration || sig.spin == ResponseSpin::energy)))
+    return Status::invalid_shape;
   // The spread's size is its model's; an empirical table stores 1 to max_empirical_outcomes
   // outcomes a cell.
   const std::uint32_t s = r.spread_per_cell;
@@ -179,9 +181,10 @@ Status check_signature_values(const SignatureView<D>& sig)
   if (sig.mass > 0 && (sig.mass < limits::min_mass || sig.mass > limits::max_mass)) return Status::out_of_range;
   if (m.rolling_resistance < 0 || sig.restitution_threshold < 0) return Status::invalid_material;
   if (sig.unit_inertia[0] < 0 || sig.unit_inertia[1] < 0 || sig.unit_inertia[2] < 0) return Status::invalid_shape;
-  // `gyration` divides the drawn spin by each radius of gyration: every moment must be recorded
-  // and not vanish against L^2 (a needle 1e4 times longer than thick is still above).
-  if (sig.spin == ResponseSpin::gyration)
+  // `gyration` and `energy` divide the drawn spin by each radius of gyration (`energy` the
+  // incoming one by their mean): every moment must be recorded and not vanish against L^2 (a
+  // needle 1e4 times longer than thick is still above).
+  if (sig.spin != ResponseSpin::length)
     for (const Scalar k : sig.unit_inertia)
       if (!(k > Scalar(1e-8) * sig.length * sig.length)) return Status::invalid_shape;
   const HeightTableView& h = sig.height;

@@ -143,7 +143,8 @@ std::string table_prologue(const std::string& name, int minor, const TableTarget
     // define the types the table names, so the compiler would stop at them first.
     const std::string full = version + "." + std::to_string(minor);
     const std::string what =
-        minor >= 4   ? " (spin by gyration): update statsim, or regenerate the table with --response-spin length"
+        minor >= 5   ? " (spin by energy): update statsim, or regenerate the table with --response-spin gyration"
+        : minor == 4 ? " (spin by gyration): update statsim, or regenerate the table with --response-spin length"
         : minor == 3 ? " (settling data): update statsim, or regenerate the table without --settle"
         : minor == 2 ? " (landing data): update statsim, or regenerate the table with --no-landing"
                      : " (body-body data): update statsim, or regenerate the table with --no-body-contacts";

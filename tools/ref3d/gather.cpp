@@ -63,18 +63,14 @@ GatherResult gather(const GatherOptions& options)
   }
 
   // 2. Responses (the trials are kept for the spin measure).
-  std::vector<ResponseTrial> all;
-  {
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<double> fixed_speed{o.speed};
-    const std::vector<double>& speeds = o.with_speed ? o.speeds : fixed_speed;
-    r.axes = {o.cos_theta, o.cos_phi};
-    if (o.with_speed) r.axes.push_back(o.speeds);
-    r.axes.push_back(o.spin_ratios);
-    const std::size_t nt = o.cos_theta.size(), np = o.cos_phi.size(), nv = speeds.size(), ns = o.spin_ratios.size();
-    const std::size_t cells = nt * np * nv * ns, trials = static_cast<std::size_t>(o.trials);
-    all.resize(cells * trials);
-    Progress progress("responses", cells * trials, o.progress);
+  const std::vector<double> fixed_speed{o.speed};
+  const std::vector<double>& speeds = o.with_speed ? o.speeds : fixed_speed;
+  const std::size_t nt = o.cos_theta.size(), np = o.cos_phi.size(), nv = speeds.size(), ns = o.spin_ratios.size();
+  const std::size_t cells = nt * np * nv * ns, trials = static_cast<std::size_t>(o.trials);
+  // Every cell's trials, at spin ratios by length or by energy (trial_spin).
+  const auto response_trials = [&](bool by_energy, const char* stage) {
+    std::vector<ResponseTrial> all(cells * trials);
+    Progress progress(stage, cells * trials, o.progress);
     parallel_for(
         cells,
         [&](std::size_t cell) {
@@ -83,13 +79,22 @@ GatherResult gather(const GatherOptions& options)
           pool.with([&](const Reference& ref) {
             for (std::size_t t = 0; t < trials; ++t)
               all[cell * trials + t] = response_trial(ref, o, o.cos_theta[it], o.cos_phi[ip], speeds[iv],
-                                                      o.spin_ratios[is], kResponseStream, cell * trials + t);
+                                                      o.spin_ratios[is], kResponseStream, cell * trials + t, by_energy);
             return 0;
           });
           progress.add(trials);
         },
         threads);
     progress.finish();
+    return all;
+  };
+  std::vector<ResponseTrial> all;
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    r.axes = {o.cos_theta, o.cos_phi};
+    if (o.with_speed) r.axes.push_back(o.speeds);
+    r.axes.push_back(o.spin_ratios);
+    all = response_trials(o.response_spin == SpinOption::energy, "responses");
     static_cast<ResponseFit&>(r) = fit_responses(all, trials, nt, np, nv, o.spin_ratios);
     r.response_seconds = seconds_since(t0);
   }
@@ -115,8 +120,17 @@ GatherResult gather(const GatherOptions& options)
   // 4. Body-body data.
   if (o.body_contacts) gather_body_contacts(r);
 
-  // 5. The spin measure (gather_spin.hpp), before the landing data, whose draws read it.
+  // 5. The spin measure (gather_spin.hpp), before the landing data, whose draws read it. Where
+  // auto finds gyration better, the table is by energy: its cells' trials again, at spin ratios
+  // by energy, as the runtime will look them up (the same seeds: only the spins' lengths differ).
   choose_spin(r, all);
+  if (o.response_spin == SpinOption::automatic && r.spin == ResponseSpin::gyration) {
+    const auto t0 = std::chrono::steady_clock::now();
+    all = response_trials(true, "responses by energy");
+    static_cast<ResponseFit&>(r) = fit_responses(gyration_values(all), trials, nt, np, nv, o.spin_ratios);
+    r.spin = ResponseSpin::energy;
+    r.response_seconds += seconds_since(t0);
+  }
 
   // 6. Landing data, against the tables as the runtime reads them (the JSON's, at the stored
   // precision; it has no landing data yet).

@@ -45,7 +45,7 @@ std::string speed_check_report(const GatherOptions& options, const std::vector<d
           // The same orientations at every speed (index independent of the speed): paired samples.
           for (std::size_t t = 0; t < n; ++t)
             all[task * n + t] = response_trial(ref, o, cells[c].cos_theta, cells[c].cos_phi, speeds[v],
-                                               cells[c].spin_ratio, kCheckStream, c * n + t);
+                                               cells[c].spin_ratio, kCheckStream, c * n + t, false);
           return 0;
         });
         progress.add(n);

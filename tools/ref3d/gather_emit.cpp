@@ -194,11 +194,14 @@ std::string header_text(const GatherResult& r, const std::string& command)
   }
   // The spin measure (format 2.4) comes last in the initialiser, after the landing data it needs
   // (gather_spin.hpp never takes gyration without it) and the settling data or its `{}`.
-  const bool gyration = r.spin == ResponseSpin::gyration;
+  const bool gyration = r.spin != ResponseSpin::length, energy = r.spin == ResponseSpin::energy;
   if (gyration && !landing) throw std::runtime_error("a table with the spin by gyration needs the landing data");
   if (gyration) {
     const SpinTest& t = r.spin_test;
-    h << "// Response spin: by gyration, K W+ / |V-| (statsim::ResponseSpin::gyration)";
+    if (energy)
+      h << "// Response spin: by energy, K W+ / |V-|, looked up at |K W-| L / (k |V-|) (statsim::ResponseSpin::energy)";
+    else
+      h << "// Response spin: by gyration, K W+ / |V-| (statsim::ResponseSpin::gyration)";
     if (t.run)
       h << "; test: KS of |V+| and |W+| against the trials by gyration " << fmt("%.4f", t.ks_gyration)
         << ", by length " << fmt("%.4f", t.ks_length) << " (auto takes gyration below length - "
@@ -206,7 +209,7 @@ std::string header_text(const GatherResult& r, const std::string& command)
         << ", by length " << fmt("%.4f", t.clamp_length);
     h << "\n";
   }
-  h << table_prologue(o.name, gyration ? 4 : settle ? 3 : landing ? 2 : contact ? 1 : 0, o.target);
+  h << table_prologue(o.name, energy ? 5 : gyration ? 4 : settle ? 3 : landing ? 2 : contact ? 1 : 0, o.target);
   const std::size_t a0 = r.axes[0].size(), a1 = r.axes[1].size(), a2 = r.axes[2].size(),
                     a3 = r.axes.size() > 3 ? r.axes[3].size() : 1;
   h << table_definition(std::string(o.i16 ? "SignatureQ16" : "Signature") + "<3, " +
@@ -292,7 +295,10 @@ std::string header_text(const GatherResult& r, const std::string& command)
   }
   if (gyration) {
     if (!settle) h << table_entry("{}", "no settling data");
-    h << table_entry("statsim::ResponseSpin::gyration", "spin components: K W+ / |V-|");
+    if (energy)
+      h << table_entry("statsim::ResponseSpin::energy", "spin components: K W+ / |V-|; spin ratio |K W-| L / (k |V-|)");
+    else
+      h << table_entry("statsim::ResponseSpin::gyration", "spin components: K W+ / |V-|");
   }
   h << table_epilogue(o.target);
   return h.str();
@@ -371,7 +377,7 @@ std::string json_text(const GatherResult& r, const std::string& command)
                    {"worst_error", std::max(qm.worst_error, qs.worst_error)}};
   }
   // Only a table by gyration names its spin measure: a JSON without "spin" is by length.
-  if (r.spin == ResponseSpin::gyration) resp["spin"] = "gyration";
+  if (r.spin != ResponseSpin::length) resp["spin"] = r.spin == ResponseSpin::energy ? "energy" : "gyration";
   if (r.spin_test.run) {
     const SpinTest& t = r.spin_test;
     resp["spin_test"] = {{"draws", t.trials},          {"ks_length", t.ks_length},
@@ -484,9 +490,10 @@ std::string summary_text(const GatherResult& r)
       << c.packing_pairs[1] << ", " << c.packing_pairs[2] << " pairs; " << c.piles << " piles, " << c.bins << " bins, "
       << fmt("%.1f", c.packing_seconds) << " s)\n";
   }
-  if (r.spin_test.run || r.spin == ResponseSpin::gyration) {
+  if (r.spin_test.run || r.spin != ResponseSpin::length) {
     const SpinTest& t = r.spin_test;
-    s << "response spin: by " << (r.spin == ResponseSpin::gyration ? "gyration" : "length");
+    s << "response spin: by "
+      << (r.spin == ResponseSpin::energy ? "energy" : r.spin == ResponseSpin::gyration ? "gyration" : "length");
     if (t.run)
       s << "; KS of |V+| and |W+| of " << t.trials << " draws against the trials: by length " << fmt("%.4f", t.ks_length)
         << ", by gyration " << fmt("%.4f", t.ks_gyration) << " (gyration taken below length - " << fmt("%.4f", t.critical)

@@ -5,6 +5,7 @@
 #include "common/parallel.hpp"
 #include "common/pi.hpp"
 #include "common/progress.hpp"
+#include "ref3d/gather_trials.hpp"
 #include "ref3d/sampling.hpp"
 #include "statsim/statistical.hpp"
 
@@ -37,7 +38,8 @@ LandingTrial landing_trial(const Reference& ref, const GatherOptions& o, const S
   RigidState s0;
   s0.orientation = rng.rotation();
   s0.velocity = speed * vhat;
-  s0.spin = rng.direction() * (spin_ratio * speed / L);
+  // At the ratio the runtime looks the landing data up at, by the table's spin measure.
+  s0.spin = trial_spin(m, s0.orientation, rng.direction(), spin_ratio, speed, tables.spin == ResponseSpin::energy);
   s0.position = Eigen::Vector3d(0, 0, L * (1 + 1e-9));
   const FreeFlight flight(m.unit_inertia);
   const FirstContact fc = first_contact(m.hull, L, flight, s0, 0.0, std::numeric_limits<double>::infinity(),

@@ -107,9 +107,10 @@ void validate_gather_options(const GatherOptions& o)
     if (!(o.landing_hop >= 0 && o.landing_hop <= 1)) fail("--landing-hop must be in [0, 1]");
     if (!(o.landing_time > 0 && o.landing_time <= 60)) fail("--landing-time must be in (0, 60] s");
   }
-  if (o.response_spin == SpinOption::gyration && !(o.landing && o.body_contacts))
-    fail("--response-spin gyration needs the landing data, which a table holds before it (drop --no-landing and "
-         "--no-body-contacts)");
+  if ((o.response_spin == SpinOption::gyration || o.response_spin == SpinOption::energy) &&
+      !(o.landing && o.body_contacts))
+    fail(std::string("--response-spin ") + (o.response_spin == SpinOption::energy ? "energy" : "gyration") +
+         " needs the landing data, which a table holds before it (drop --no-landing and --no-body-contacts)");
   if (o.settle) {
     if (o.settle_quantiles < 1 || o.settle_quantiles > static_cast<int>(max_settle_quantiles))
       fail("--settle-quantiles must be in [1, " + std::to_string(max_settle_quantiles) + "]");

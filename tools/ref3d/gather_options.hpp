@@ -26,9 +26,10 @@ std::vector<double> default_coarse_speeds();   ///< the coarse speed axis, m/s
 std::vector<double> default_landing_froude();  ///< 4 Froude numbers |V-|^2 / (g L): 0, 1, 4, 16
 
 /// The spin measure of the response table (--response-spin): statsim::ResponseSpin, or, by
-/// default, the one whose runtime draws match the trials' spins measurably better
-/// (gather_spin.hpp); `gyration` needs the landing data, which a table holds before it.
-enum class SpinOption { automatic, length, gyration };
+/// default, length or, where the runtime's draws by gyration match the trials' spins measurably
+/// better, energy (gather_spin.hpp); `gyration` and `energy` need the landing data, which a
+/// table holds before them.
+enum class SpinOption { automatic, length, gyration, energy };
 
 struct GatherOptions {
   std::string shape = "box";  ///< box, lshape, bunny (ignored when mesh_file is set)

@@ -43,13 +43,13 @@ Draws draw_spins(const GatherResult& r, const std::vector<ResponseTrial>& all)
   return d;
 }
 
-std::vector<ResponseTrial> with_gyration(std::vector<ResponseTrial> all)
+}  // namespace
+
+std::vector<ResponseTrial> gyration_values(std::vector<ResponseTrial> all)
 {
   for (ResponseTrial& t : all) t.value = t.gyration;
   return all;
 }
-
-}  // namespace
 
 void choose_spin(GatherResult& r, const std::vector<ResponseTrial>& all)
 {
@@ -58,11 +58,16 @@ void choose_spin(GatherResult& r, const std::vector<ResponseTrial>& all)
   r.spin_test = SpinTest{};
   // The spin measure follows the landing data in a table: without it, the paper's.
   if (o.response_spin == SpinOption::length || !o.landing || !o.body_contacts) return;
-  const auto t0 = std::chrono::steady_clock::now();
   const std::size_t nt = o.cos_theta.size(), np = o.cos_phi.size(), nv = o.with_speed ? o.speeds.size() : 1;
   const std::size_t trials = static_cast<std::size_t>(o.trials);
+  if (o.response_spin == SpinOption::energy) {  // the trials were made by energy: no test
+    static_cast<ResponseFit&>(r) = fit_responses(gyration_values(all), trials, nt, np, nv, o.spin_ratios);
+    r.spin = ResponseSpin::energy;
+    return;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
   GatherResult g = r;
-  static_cast<ResponseFit&>(g) = fit_responses(with_gyration(all), trials, nt, np, nv, o.spin_ratios);
+  static_cast<ResponseFit&>(g) = fit_responses(gyration_values(all), trials, nt, np, nv, o.spin_ratios);
   g.spin = ResponseSpin::gyration;
   // The trials' |V+| / |V-| and |W+| L / |V-|, from the state each body left the ground with.
   const double L = r.model.bounding_radius;

@@ -11,6 +11,14 @@
 // impacts mostly spin it about one body axis, energy kept on the wrong axis becomes a faster
 // spin. Neither is right for every shape, so the trials decide.
 //
+// Where gyration wins, auto takes `energy` (format 2.5): gyration, with the trials made again at
+// spin ratios by energy, |K W-| L / (k |V-|), which the runtime then looks the table up at. The
+// trials by length put, in one cell, spins about every body axis with the same |W-|, so on such
+// a shape their energies differ by up to I_max / I_min: a rod rolling fast about its long axis
+// was looked up among trials that spun about short axes with many times its energy, and
+// bounced as they did. The test itself compares length and gyration on the trials by length,
+// so a shape that keeps length keeps its table to the byte.
+//
 // K is taken at the orientation the body leaves the ground with, the one W+ belongs to (after a
 // long contact the body has turned since it met the ground): half the squared length of K W+ /
 // |V-| is then exactly the rotational share of the energy it leaves with.
@@ -35,7 +43,8 @@ namespace statsim::tools::ref3d {
 struct GatherResult;
 
 /// What the test measured (a part of GatherResult); `run` false with --response-spin length or
-/// without the landing data. With --response-spin gyration it is run and reported, not obeyed.
+/// energy, or without the landing data. With --response-spin gyration it is run and reported, not
+/// obeyed.
 struct SpinTest {
   bool run = false;
   long long trials = 0;      ///< draws of each candidate, one per response trial
@@ -46,10 +55,15 @@ struct SpinTest {
   double seconds = 0.0;
 };
 
-/// Sets `r.spin` by `r.options.response_spin`, and `r.spin_test` unless that is length; when
-/// gyration is taken, `r`'s response statistics become the fit of the trials' gyration values. `all` holds
-/// the response trials as `fit_responses` takes them; `r` must hold everything a table holds
-/// before its landing data (the draws read the table from its JSON).
+/// Sets `r.spin` by `r.options.response_spin`, and `r.spin_test` unless that is length or energy;
+/// when gyration or energy is taken, `r`'s response statistics become the fit of the trials'
+/// gyration values. `all` holds the response trials as `fit_responses` takes them (by energy for
+/// --response-spin energy); `r` must hold everything a table holds before its landing data (the
+/// draws read the table from its JSON). Where auto finds gyration better, it leaves `r.spin`
+/// gyration: the caller makes the trials by energy and takes `energy` (gather.cpp).
 void choose_spin(GatherResult& r, const std::vector<ResponseTrial>& all);
+
+/// The trials with their gyration values (K W+ / |V-|) in place of their values by length.
+std::vector<ResponseTrial> gyration_values(std::vector<ResponseTrial> all);
 
 }  // namespace statsim::tools::ref3d

@@ -27,8 +27,19 @@ double height_trial(const ShapeModel& m, double spin_ratio, std::uint64_t seed, 
   return fc.state.position.z() - lowest_point(m.hull, fc.state);
 }
 
+Eigen::Vector3d trial_spin(const ShapeModel& m, const Eigen::Quaterniond& orientation, const Eigen::Vector3d& axis,
+                           double spin_ratio, double speed, bool by_energy)
+{
+  const Eigen::Vector3d w = axis * (spin_ratio * speed / m.bounding_radius);
+  if (!by_energy) return w;
+  const Eigen::Vector3d b = orientation.conjugate() * axis;
+  const double kw2 = m.unit_inertia.dot(b.cwiseProduct(b)), k2 = m.unit_inertia.sum() / 3.0;
+  return w * std::sqrt(k2 / kw2);
+}
+
 ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, double cos_theta, double cos_phi,
-                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index)
+                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index,
+                             bool by_energy)
 {
   const ShapeModel& m = ref.model();
   TrialRng rng(o.seed, stream, index);
@@ -43,7 +54,7 @@ ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, doubl
   RigidState s0;
   s0.orientation = rng.rotation();
   s0.velocity = speed * vhat;
-  s0.spin = wdir * (spin_ratio * speed / L);
+  s0.spin = trial_spin(m, s0.orientation, wdir, spin_ratio, speed, by_energy);
   s0.position = Eigen::Vector3d(0, 0, L * (1 + 1e-9));
   const FreeFlight flight(m.unit_inertia);
   const FirstContact fc = first_contact(m.hull, L, flight, s0, 0.0, std::numeric_limits<double>::infinity(),

@@ -28,9 +28,18 @@ struct ResponseTrial {
   double max_penetration = 0.0;
   int steps = 0;
 };
-/// The impact of cell (cos theta, cos phi, speed, spin ratio), trial `index` of `stream`.
+/// The spin a trial meets the ground with at spin ratio `spin_ratio` and speed |V-| `speed`
+/// (m/s), about the world-frame unit axis `axis`, for a body at orientation `orientation`:
+/// |W-| = spin_ratio |V-| / L, or with `by_energy` (statsim::ResponseSpin::energy) the |W-| that
+/// gives |K W-| / k = spin_ratio |V-| / L, k^2 = tr(I / m) / 3, as the runtime looks it up.
+Eigen::Vector3d trial_spin(const ShapeModel& model, const Eigen::Quaterniond& orientation, const Eigen::Vector3d& axis,
+                           double spin_ratio, double speed, bool by_energy);
+
+/// The impact of cell (cos theta, cos phi, speed, spin ratio), trial `index` of `stream`; with
+/// `by_energy` at a spin ratio by energy (`trial_spin`).
 ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, double cos_theta, double cos_phi,
-                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index);
+                             double speed, double spin_ratio, std::uint64_t stream, std::uint64_t index,
+                             bool by_energy);
 
 /// One h_coll flight: the centre height at first contact.
 double height_trial(const ShapeModel& model, double spin_ratio, std::uint64_t seed, std::uint64_t index);

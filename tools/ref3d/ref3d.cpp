@@ -207,6 +207,7 @@ void run(const GatherCommand& c, const CLI::App& sub)
     o.response_model = parse_response_model(c.response_model);
     o.response_spin = c.response_spin == "length"     ? SpinOption::length
                       : c.response_spin == "gyration" ? SpinOption::gyration
+                      : c.response_spin == "energy"   ? SpinOption::energy
                                                       : SpinOption::automatic;
     o.reference.mesh_hull = c.mesh_shape == "hull";
     o.body_contacts = !c.no_body_contacts;
@@ -369,9 +370,11 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
   sub->add_option("--response-spin", c->response_spin,
                   "What the response table's spin measures: length = W+ L / |V-| (the paper's); gyration = K W+ / "
                   "|V-|, K the radii of gyration at the body's orientation, so a draw's rotational energy does not "
-                  "depend on how the body is turned (needs the landing data); auto = gyration only when the "
-                  "runtime's draws match the trials' spins measurably better (statsim/signature.hpp, ResponseSpin)")
-      ->check(CLI::IsMember({"auto", "length", "gyration"}))
+                  "depend on how the body is turned (needs the landing data); energy = gyration, and the trials "
+                  "and the table's spin-ratio coordinate measure the incoming spin by its energy too, |K W-| L / "
+                  "(k |V-|); auto = energy only when the runtime's draws by gyration match the trials' spins "
+                  "measurably better, else length (statsim/signature.hpp, ResponseSpin)")
+      ->check(CLI::IsMember({"auto", "length", "gyration", "energy"}))
       ->capture_default_str();
   sub->add_option("--empirical-outcomes", o.empirical_outcomes,
                   "Outcomes stored per cell by --response-model empirical (1 to --trials, at most 64)")

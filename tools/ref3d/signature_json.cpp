@@ -158,7 +158,8 @@ void parse_parts(const json& j, BasicLoadedSignature3<Responses>& s, const std::
     const json& m = r.at("spin");
     if (m == "length") s.spin = ResponseSpin::length;
     else if (m == "gyration") s.spin = ResponseSpin::gyration;
-    else fail(origin, "field 'response.spin' is neither \"length\" nor \"gyration\"");
+    else if (m == "energy") s.spin = ResponseSpin::energy;
+    else fail(origin, "field 'response.spin' is not \"length\", \"gyration\" or \"energy\"");
   }
   std::vector<Scalar> mean = numbers(r, "mean", origin, "response.");
   std::vector<Scalar> spread = numbers(r, r.contains("spread") ? "spread" : "std", origin, "response.");
