@@ -151,9 +151,7 @@ std::uint32_t response_coordinates(const SignatureView<D>& sig, const ContactFra
     if (sig.spin == ResponseSpin::energy) {
       // |K W-| / k: |K W-|^2 = W^T (I / m) W is twice the rotational energy per unit mass, and
       // k^2 = tr(I / m) / 3 its mean over spin axes drawn uniformly, as the trials draw them.
-      const Vector3 wb = orientation.conjugate() * w;
-      const Scalar kw2 = sig.unit_inertia[0] * wb.x() * wb.x() + sig.unit_inertia[1] * wb.y() * wb.y() +
-                         sig.unit_inertia[2] * wb.z() * wb.z();
+      const Scalar kw2 = 2 * kinetic_energy_per_mass<3>(sig, orientation, Vector3::Zero(), w);
       const Scalar k2 = (sig.unit_inertia[0] + sig.unit_inertia[1] + sig.unit_inertia[2]) / 3;
       spin = std::sqrt(kw2 / k2);
     }

@@ -124,9 +124,10 @@ GatherResult gather(const GatherOptions& options)
   // auto finds gyration better, the table is by energy: its cells' trials again, at spin ratios
   // by energy, as the runtime will look them up (the same seeds: only the spins' lengths differ).
   choose_spin(r, all);
-  if (o.response_spin == SpinOption::automatic && r.spin == ResponseSpin::gyration) {
+  const bool auto_energy = o.response_spin == SpinOption::automatic && r.spin == ResponseSpin::gyration;
+  if (auto_energy || o.response_spin == SpinOption::energy) {
     const auto t0 = std::chrono::steady_clock::now();
-    all = response_trials(true, "responses by energy");
+    if (auto_energy) all = response_trials(true, "responses by energy");
     static_cast<ResponseFit&>(r) = fit_responses(gyration_values(all), trials, nt, np, nv, o.spin_ratios);
     r.spin = ResponseSpin::energy;
     r.response_seconds += seconds_since(t0);

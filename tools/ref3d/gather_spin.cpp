@@ -56,16 +56,13 @@ void choose_spin(GatherResult& r, const std::vector<ResponseTrial>& all)
   const GatherOptions& o = r.options;
   r.spin = ResponseSpin::length;
   r.spin_test = SpinTest{};
-  // The spin measure follows the landing data in a table: without it, the paper's.
-  if (o.response_spin == SpinOption::length || !o.landing || !o.body_contacts) return;
+  // The spin measure follows the landing data in a table: without it, the paper's. Given
+  // `energy`, the caller fits the trials it made by energy: no test.
+  const bool untested = o.response_spin == SpinOption::length || o.response_spin == SpinOption::energy;
+  if (untested || !o.landing || !o.body_contacts) return;
+  const auto t0 = std::chrono::steady_clock::now();
   const std::size_t nt = o.cos_theta.size(), np = o.cos_phi.size(), nv = o.with_speed ? o.speeds.size() : 1;
   const std::size_t trials = static_cast<std::size_t>(o.trials);
-  if (o.response_spin == SpinOption::energy) {  // the trials were made by energy: no test
-    static_cast<ResponseFit&>(r) = fit_responses(gyration_values(all), trials, nt, np, nv, o.spin_ratios);
-    r.spin = ResponseSpin::energy;
-    return;
-  }
-  const auto t0 = std::chrono::steady_clock::now();
   GatherResult g = r;
   static_cast<ResponseFit&>(g) = fit_responses(gyration_values(all), trials, nt, np, nv, o.spin_ratios);
   g.spin = ResponseSpin::gyration;

@@ -55,12 +55,11 @@ struct SpinTest {
   double seconds = 0.0;
 };
 
-/// Sets `r.spin` by `r.options.response_spin`, and `r.spin_test` unless that is length or energy;
-/// when gyration or energy is taken, `r`'s response statistics become the fit of the trials'
-/// gyration values. `all` holds the response trials as `fit_responses` takes them (by energy for
-/// --response-spin energy); `r` must hold everything a table holds before its landing data (the
-/// draws read the table from its JSON). Where auto finds gyration better, it leaves `r.spin`
-/// gyration: the caller makes the trials by energy and takes `energy` (gather.cpp).
+/// Sets `r.spin` to length or gyration by `r.options.response_spin` (length for `energy`, which
+/// the caller takes, gather.cpp), and `r.spin_test` unless that is length or energy; when
+/// gyration is taken, `r`'s response statistics become the fit of the trials' gyration values.
+/// `all` holds the response trials as `fit_responses` takes them; `r` must hold everything a
+/// table holds before its landing data (the draws read the table from its JSON).
 void choose_spin(GatherResult& r, const std::vector<ResponseTrial>& all);
 
 /// The trials with their gyration values (K W+ / |V-|) in place of their values by length.
