@@ -139,6 +139,7 @@ constexpr auto table3 = statsim::quantize16(FIRMWARE_TABLE);
 constexpr auto table2 = statsim::quantize16(statsim::tables::square2d);
 constexpr auto correlated = statsim::quantize16(statsim::testing::cube_correlated_synthetic);
 constexpr auto empirical = statsim::quantize16(statsim::testing::cube_empirical_synthetic);
+constexpr auto energy = statsim::quantize16(statsim::testing::cube_energy_synthetic);
 constexpr const char* precision = "i16";
 #else
 // Float tables, also from a committed table in 16 bits, so that both builds step both paths.
@@ -146,10 +147,13 @@ constexpr auto table3 = statsim::dequantize(FIRMWARE_TABLE);
 constexpr const auto& table2 = statsim::tables::square2d;
 constexpr const auto& correlated = statsim::testing::cube_correlated_synthetic;
 constexpr const auto& empirical = statsim::testing::cube_empirical_synthetic;
+constexpr const auto& energy = statsim::testing::cube_energy_synthetic;
 constexpr const char* precision = "f32";
 #endif
-// The committed tables hold the default response model; a small third world steps the others
-// (hand-made cubes, tools/scenes/synthetic_signatures.hpp) so that every model is compared.
+// The committed tables hold the default response model and spin measure; a small third world
+// steps the others (hand-made cubes, tools/scenes/synthetic_signatures.hpp: the correlated and
+// empirical models, and the spin by energy of a body with unequal moments) so that every
+// sampler is compared.
 constexpr std::uint32_t model_bodies = 16;
 
 // ---- output without printf (newlib's printf allocates) -------------------------------------------
@@ -213,7 +217,7 @@ constexpr statsim::Features features = FIRMWARE_FEATURE_SET;
 statsim::World3<bodies, 8, pairs3, 2, 0, sweep_only, features> world3;
 #if !FIRMWARE_ONLY3
 statsim::World2<bodies, 8, pairs2, 2, 0, sweep_only, features> world2;
-statsim::World3<model_bodies, 1, 4 * model_bodies, 2, 0, sweep_only, features> world_models;
+statsim::World3<model_bodies, 1, 4 * model_bodies, 3, 0, sweep_only, features> world_models;
 #endif
 
 #if FIRMWARE_SNAPSHOT
@@ -301,11 +305,12 @@ bool build_world_models()
 {
   const auto a = world_models.add_shape(correlated.view());
   const auto b = world_models.add_shape(empirical.view());
-  if (!a.ok() || !b.ok() || !world_models.add_plane(statsim::Vector3(0, 0, 1), 0).ok()) return false;
+  const auto c = world_models.add_shape(energy.view());
+  if (!a.ok() || !b.ok() || !c.ok() || !world_models.add_plane(statsim::Vector3(0, 0, 1), 0).ok()) return false;
   statsim::Pcg32 rng(7, 4);
   for (std::uint32_t i = 0; i < model_bodies; ++i) {
     statsim::BodyDef3 def;
-    def.shape = i % 2 ? b.id : a.id;
+    def.shape = i % 3 == 0 ? a.id : (i % 3 == 1 ? b.id : c.id);
     def.position = statsim::Vector3(0.3f * float(i % 4), 0.3f * float(i / 4), 0.3f + 0.1f * float(i % 3));
     def.orientation = random_orientation(rng);
     const float wx = rng.uniform(-5, 5);
@@ -461,7 +466,7 @@ int main()
 #if FIRMWARE_SNAPSHOT
   const bool ok3 = run(world3, "world3", table3.name, snapshot3, sizeof snapshot3, &snapshot3_size);
   const bool ok2 = run(world2, "world2", table2.name, snapshot2, sizeof snapshot2, &snapshot2_size);
-  const bool ok_models = run(world_models, "models", "cube_correlated_and_empirical");
+  const bool ok_models = run(world_models, "models", "cube_correlated_empirical_energy");
   const bool ok_snapshots = continue_snapshot(world3, "snap3", snapshot3, snapshot3_size, true) &&
                             continue_snapshot(world2, "snap2", snapshot2, snapshot2_size, true);
 #elif FIRMWARE_ONLY3
@@ -470,7 +475,7 @@ int main()
 #else
   const bool ok3 = run(world3, "world3", table3.name);
   const bool ok2 = run(world2, "world2", table2.name);
-  const bool ok_models = run(world_models, "models", "cube_correlated_and_empirical");
+  const bool ok_models = run(world_models, "models", "cube_correlated_empirical_energy");
   const bool ok_snapshots = true;
 #endif
 #ifdef STATSIM_FIRMWARE

@@ -115,4 +115,17 @@ inline constexpr auto cube_empirical_synthetic =
       o[3 * 6 + 5] = -0.04f * f;
     });
 
+/// The cube's table on a body of unequal moments, its spin measured by energy (format 2.5,
+/// `ResponseSpin::energy`): the tables of `cube_synthetic` and the moments over mass of a
+/// 0.1 x 0.2 x 0.4 m box, (b^2 + c^2) / 12 and so on, whose ratio 4 between largest and
+/// smallest makes the lookup's |K W-| L / (k |V-|) and the draw's R diag(sqrt(m / I_k)) R^T
+/// differ from the paper's by the body's orientation.
+inline constexpr auto cube_energy_synthetic = [] {
+  auto s = cube_synthetic;
+  s.name = "cube_energy_synthetic";
+  s.unit_inertia = {0.2f / 12, 0.17f / 12, 0.05f / 12};
+  s.spin = ResponseSpin::energy;
+  return s;
+}();
+
 }  // namespace statsim::testing
