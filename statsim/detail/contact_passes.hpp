@@ -53,11 +53,12 @@ constexpr Scalar contact_slop = Scalar(1e-3);
 /// shapes (paper 3.3.2; for body-body contacts each body responds on its own, as in the
 /// paper), the rest turn for bodies settling on the ground (paper 3.4), else (plain spheres,
 /// and resting contacts of statistical bodies) the particle response against a static plane.
-/// `tilted_plane`: the contact is with a plane that gravity pulls the body along.
+/// `tilted_plane`: the contact is with a plane that gravity pulls the body along. `sunk` (m):
+/// how far the step had taken the body into the plane, for a plane contact of the impact pass.
 template <int D, class FS>
 void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, const typename Space<D>::Vec& n,
                    const typename Space<D>::Vec& other_velocity, bool ground_contact, bool tilted_plane = false,
-                   Scalar gap = 0)
+                   Scalar gap = 0, Scalar sunk = 0)
 {
   using Vec = typename Space<D>::Vec;
   const Shape<D>& shape = w.shapes[b.shape];
@@ -152,6 +153,17 @@ void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, cons
     // Against a plane, the part of gravity pressing the body onto it decides how often the
     // body stays there (the signature's landing data); body-body contacts take none.
     const Scalar gravity = ground_contact ? Scalar(-def.gravity.dot(n)) : Scalar(0);
+    // The table is looked up at the impact, the velocity the sphere met the plane with: it
+    // crossed it about `sunk` / |v_n| before the step's end (at most the step), and gravity has
+    // added g that long since. At 60 Hz that is up to g dt, 0.16 m/s, and g dt / 2 on average,
+    // by which every response would be scaled up.
+    if (gravity > 0 && sunk > 0) {
+      const Scalar vn = v.dot(n);
+      if (vn < 0) {
+        const Scalar since = sunk < -vn * ctx.dt ? sunk / -vn : ctx.dt;
+        v -= def.gravity * since;
+      }
+    }
     const ResponseOutcome o =
         statistical_response<D>(shape.signature, b.orientation, n, v, b.angular_velocity, rng, gravity);
     b.rng_state = rng.state();
@@ -234,8 +246,9 @@ void correct_overlap(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& a, Bo
 
 /// The shared loop over plane contacts: for every awake body and plane that touch (spheres grown
 /// by `contact_slop` when `grown`), moves the body out of the plane, marks it touching (and on
-/// the ground for a near-horizontal plane), then calls `respond(body, contact, ground, tilted)`
-/// (tilted: gravity pulls the body along the plane); on a tilted plane it then takes the
+/// the ground for a near-horizontal plane), then calls `respond(body, contact, ground, tilted,
+/// moved)` (tilted: gravity pulls the body along the plane; moved: how far, m, the body was just
+/// moved out of it); on a tilted plane it then takes the
 /// downhill move back that the response's friction cancelled.
 /// Returns the number of contacts.
 template <int D, class FS, class Respond>
@@ -257,8 +270,9 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext<FS>& ctx, bool grown, 
       const Scalar slop = hull ? w.shapes[b.shape].bounding_radius * slope_reach
                                : (grown ? b.radius * contact_slop : Scalar(0));
       if (!sphere_plane_contact<D>(b.position, plane_radius<FS>(w, b, w.planes[p]) + slop, w.planes[p], c)) continue;
-      if (c.depth > slop) {
-        b.position += c.normal * (c.depth - slop);
+      const Scalar moved = c.depth > slop ? c.depth - slop : Scalar(0);
+      if (moved > 0) {
+        b.position += c.normal * moved;
         ++ctx.moves;
         ++ctx.changes;
       }
@@ -277,14 +291,14 @@ std::uint32_t plane_contacts(WorldData<D>& w, StepContext<FS>& ctx, bool grown, 
       // (g_t = 0 exactly) are left alone.
       Scalar gn;
       if (!FS::slopes || !ctx.tilted_planes || !is_tilted_plane(g, c.normal, gn)) {
-        respond(b, c, ground, false);
+        respond(b, c, ground, false, moved);
         continue;
       }
       const Vec gt = g - c.normal * gn;
       const Scalar pull = gt.norm();
       const Vec downhill = gt / pull;
       const Scalar before = b.linear_velocity.dot(downhill);
-      respond(b, c, ground, true);
+      respond(b, c, ground, true, moved);
       const Scalar taken = before - b.linear_velocity.dot(downhill);
       const Scalar held = pull * ctx.dt;
       if (taken > 0) b.position -= downhill * ((taken < held ? taken : held) * ctx.dt);
@@ -364,7 +378,7 @@ void support_planes(WorldData<D>& w, StepContext<FS>& ctx)
   // On level ground a body that rolled on its hull in the step's substeps (`ground_hull`) meets
   // it here as every other resting body does, at its sphere: what approach the substeps left at
   // the step's end goes, and friction there brakes its slide and spin.
-  plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool tilted) {
+  plane_contacts(w, ctx, true, [&](Body<D>& b, const Contact<D>& c, bool, bool tilted, Scalar) {
     if (tilted && rolls_on<FS>(w, b, c.normal)) {
       if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)) &&
           slope_hull_response(w.shapes[b.shape], b, c.normal, w.def.gravity, -c.depth, ctx.dt, no_bounce))
@@ -386,8 +400,9 @@ std::uint32_t impact_pass(WorldData<D>& w, StepContext<FS>& ctx)
   using Vec = typename Space<D>::Vec;
   const WorldDef<D>& def = w.def;
   const std::uint32_t plane_count = plane_contacts(w, ctx, false, [&](Body<D>& b, const Contact<D>& c, bool ground,
-                                                                      bool tilted) {
-    if (FS::statistical && w.shapes[b.shape].statistical) respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground, tilted, -c.depth);
+                                                                      bool tilted, Scalar moved) {
+    if (FS::statistical && w.shapes[b.shape].statistical)
+      respond_alone(w, ctx, b, c.normal, Vec::Zero(), ground, tilted, -c.depth, moved);
     else if (particle_plane_response<D>(b.linear_velocity, b.angular_velocity, contact_radius(w, b), c.normal,
                                         w.shapes[b.shape].material, def.restitution_threshold))
       ++ctx.changes;
@@ -507,7 +522,7 @@ std::uint32_t position_pass(WorldData<D>& w, StepContext<FS>& ctx)
     correct_overlap(w, ctx, a, b, c, slop, reach, ima, imb, ims);
     return true;
   });
-  plane_contacts(w, ctx, true, [](Body<D>&, const Contact<D>&, bool, bool) {});
+  plane_contacts(w, ctx, true, [](Body<D>&, const Contact<D>&, bool, bool, Scalar) {});
   return ctx.moves;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The first phase of a step: semi-implicit Euler for the awake bodies.
+/// The first phase of a step: gravity, damping and motion of the awake bodies.
 
 #include "statsim/detail/bits.hpp"
 #include "statsim/detail/world_data.hpp"
@@ -10,10 +10,16 @@
 namespace statsim {
 namespace detail {
 
-/// Semi-implicit Euler for awake bodies: gravity and damping change the velocity, which then
-/// moves the body; orientation without trigonometry (`detail::integrate`). `own(i)` may move
-/// body i through the step itself (`roll_on_slopes`) and return true. Returns the number of
-/// bodies integrated.
+/// Gravity and damping change the velocity of each awake body, and the mean of its velocities
+/// before and after moves it; orientation without trigonometry (`detail::integrate`). `own(i)`
+/// may move body i through the step itself (`roll_on_slopes`) and return true. Returns the
+/// number of bodies integrated.
+///
+/// Why the mean: under constant gravity x + (v + v') dt / 2 = x + v dt + g dt^2 / 2 is the exact
+/// flight at any step, where semi-implicit Euler's x + v' dt takes g dt^2 / 2 too much a step.
+/// A statistical body flies between contacts, and that error shows there: a flight launched at
+/// v_n peaks v_n dt / 2 lower (4 mm of a 1 cm hop at 60 Hz), lands early, and travels less; a
+/// fall of t seconds leads by g t dt / 2. Velocities, and so every impulse, are unchanged.
 template <class FS, int D, class Own>
 std::uint32_t integrate(WorldData<D>& w, Scalar dt, Own&& own)
 {
@@ -30,9 +36,10 @@ std::uint32_t integrate(WorldData<D>& w, Scalar dt, Own&& own)
     if (b.slow_time <= 0 || !hulls || !sleeps_from_anchor<FS>(w, b)) b.step_start = b.position;
     ++count;
     if (own(i)) return;
-    b.linear_velocity = (b.linear_velocity + dv) * lin_damp;
+    const Vec before = b.linear_velocity;
+    b.linear_velocity = (before + dv) * lin_damp;
     b.angular_velocity = b.angular_velocity * ang_damp;
-    b.position += b.linear_velocity * dt;
+    b.position += (before + b.linear_velocity) * (dt / 2);
     b.orientation = integrate(b.orientation, b.angular_velocity, dt);
   });
   return count;

@@ -139,9 +139,9 @@ template <class FS, int D>
 void fall_asleep(WorldData<D>& w, Body<D>& b, std::uint32_t i, bool posed, const typename Space<D>::Vec& ground)
 {
   using Vec = typename Space<D>::Vec;
-  // Where the centre stood above the ground: `hull_radius` of the body as it was, settling (the
+  // Where the centre stood above the ground: `held_radius` of the body as it was, settling (the
   // collision radius, or the hull's support where that is more); asleep it would be the radius.
-  const Scalar above = b.rest_pose != no_rest_pose && b.on_ground && posed ? hull_radius<FS>(w, b, ground) : Scalar(0);
+  const Scalar above = b.rest_pose != no_rest_pose && b.on_ground && posed ? held_radius<FS>(w, b, ground) : Scalar(0);
   b.state = MotionState::asleep;
   clear_bit(w.awake, i);
   --w.awake_count;

@@ -152,6 +152,37 @@ Scalar hull_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
   return hull > b.radius ? hull : b.radius;
 }
 
+/// The radius at which a plane holds body `b` (one of `w`'s bodies): `hull_radius`, but on level
+/// ground with no other body near (`WorldData::paired`) no more than its collision radius plus
+/// the height its kinetic energy could lift its centre, e / g_n (e per unit mass, of its spin and
+/// of its velocity along the plane; g_n gravity's part along the normal).
+///
+/// Why: a statistical body's orientation as it starts to settle is not the one its collision
+/// radius was measured at, and its hull's support there may stand centimetres above that radius.
+/// Held at the support it was lifted there in one step with no velocity, a hop that a rigid body,
+/// whose centre rises over an edge only as far as its energy takes it, does not make
+/// (tools/fidelity/README.md, "The hull's hold"). Near other bodies and against walls the hold is
+/// whole: a body propped by others must not sink into the ground or a wall. `hull_radius` itself,
+/// which tells whether others prop a body out of its pose, is unchanged.
+template <class FS = AllFeatures, int D>
+Scalar held_radius(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  const Scalar hull = hull_radius<FS>(w, b, n);
+  if constexpr (!FS::statistical || !FS::hull_contacts) {
+    return hull;
+  }
+  if (!(hull > b.radius) || !(n[Space<D>::up_axis] >= w.def.ground_cosine) ||
+      bit_set(w.paired, std::uint32_t(&b - w.bodies)) || slope_hull<FS>(w, b, n) || ground_hull<FS>(w, b, n))
+    return hull;
+  const Scalar gn = -w.def.gravity.dot(n);
+  if (!(gn > 0)) return hull;
+  // The approach into the plane, a resting body's g dt among it, lifts nothing.
+  const typename Space<D>::Vec along = b.linear_velocity - n * b.linear_velocity.dot(n);
+  const Scalar reach =
+      b.radius + kinetic_energy_per_mass<D>(w.shapes[b.shape].signature, b.orientation, along, b.angular_velocity) / gn;
+  return hull < reach ? hull : reach;
+}
+
 /// `hull_radius` against a plane, where it matters: the support is read only when the plane is
 /// within the body's bounding radius.
 template <class FS = AllFeatures, int D>
@@ -165,7 +196,7 @@ Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& pla
   const bool hulls = FS::hull_contacts && hull_contacts_on(w) && b.state == MotionState::settling;
   if (!slopes && !ground && !hulls) return b.radius;
   if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
-  return hull_radius<FS>(w, b, plane.normal);
+  return held_radius<FS>(w, b, plane.normal);
 }
 
 }  // namespace detail
