@@ -183,7 +183,7 @@ Scalar held_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
   return hull < reach ? hull : reach;
 }
 
-/// `hull_radius` against a plane, where it matters: the support is read only when the plane is
+/// `held_radius` against a plane, where it matters: the support is read only when the plane is
 /// within the body's bounding radius.
 template <class FS = AllFeatures, int D>
 Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& plane)
