@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -584,6 +585,50 @@ TEST_CASE("fidelity: bad options fail before any run")
   CHECK(run_cli({"--shape", "box", "--reference", "nonsense", "--quiet"}) != 0);
   CHECK(run_cli({"--mesh", "tools/meshes/box.obj", "--quiet"}) != 0);  // needs --table
   CHECK(!fs::exists(json_path));
+}
+
+TEST_CASE("fidelity: --drops-csv holds every drop of every sample, and the distances recompute from it exactly")
+{
+  TempDir dir("fidelity");
+  const std::string json_path = dir.file("drops.json"), csv_path = dir.file("drops.csv");
+  const int runs = 12;
+  REQUIRE(run_cli({"--shape", "box", "--runs", std::to_string(runs), "--no-piles", "--no-timing", "--methods",
+                   "statistical", "--dt", "1/120", "--reference-dt", "1/120", "--reference", "bench", "--bootstrap",
+                   "0", "--threads", "2", "--json", json_path, "--drops-csv", csv_path, "--quiet"}) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read_file(json_path));
+  std::istringstream in(read_file(csv_path));
+  std::string line;
+  REQUIRE(std::getline(in, line));
+  CHECK(line.rfind("sample,run,impact,flight,flight_speed,flight_spin,bounces,travel,", 0) == 0);
+  // Per sample: |v+| (-1 for a drop with no flight, as the distance counts it) and travel.
+  std::map<std::string, std::vector<double>> speed, travel;
+  std::map<std::string, int> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream cells(line);
+    for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
+    REQUIRE(f.size() == 15);
+    CHECK(std::stoi(f[1]) == rows[f[0]]);  // runs in order
+    ++rows[f[0]];
+    speed[f[0]].push_back(f[3] == "1" ? std::stod(f[4]) : -1.0);
+    travel[f[0]].push_back(std::stod(f[7]));
+  }
+  CHECK(rows.size() == 3);
+  for (const char* sample : {"reference", "reference_b", "statistical"}) {
+    CAPTURE(sample);
+    CHECK(rows[sample] == runs);
+  }
+  const nlohmann::json& m = j.at("methods").at("statistical");
+  CHECK(ks(speed["statistical"], speed["reference"]) == m.at("first_impact_ks_v").get<double>());
+  CHECK(w1(travel["statistical"], travel["reference"]) / mean(travel["reference"]) ==
+        doctest::Approx(m.at("travel_w1").get<double>()).epsilon(1e-12));
+  const nlohmann::json& floor = j.at("noise_floor");
+  CHECK(ks(speed["reference_b"], speed["reference"]) == floor.at("first_impact_ks_v").get<double>());
+
+  // Nothing to write without single drops; the option fails before any run.
+  const std::string none = dir.file("none.csv");
+  CHECK(run_cli({"--shape", "box", "--scenes", "column", "--scenes-only", "--drops-csv", none, "--quiet"}) != 0);
+  CHECK(!fs::exists(none));
 }
 
 TEST_CASE("fidelity convergence: a change within its floor converges, one past it does not")

@@ -241,6 +241,10 @@ void validate(const FidelityOptions& options);
 FidelityResult run_fidelity(const FidelityOptions& options);
 
 std::string fidelity_json(const FidelityResult& result);
+/// Every single drop of every sample, one CSV row each (`--drops-csv`): the sample (reference,
+/// reference_b, or the method's name), the run's index, and the DropRun's fields, doubles written
+/// with 17 significant digits, so the distances can be recomputed from the file exactly.
+std::string drops_csv(const FidelityResult& result);
 std::string fidelity_table(const FidelityResult& result);
 /// The scenes' tables (part of fidelity_table()).
 std::string scenes_table(const FidelityResult& result);

@@ -289,6 +289,27 @@ double parse_step(const std::string& text, const char* option)
 
 }  // namespace
 
+std::string drops_csv(const FidelityResult& r)
+{
+  std::ostringstream out;
+  out.precision(17);
+  out << "sample,run,impact,flight,flight_speed,flight_spin,bounces,travel,rest_time,time_limited,settle_onset,config,"
+         "rest_height,responses,clamps\n";
+  const auto rows = [&out](const std::string& sample, const std::vector<DropRun>& drops) {
+    for (std::size_t i = 0; i < drops.size(); ++i) {
+      const DropRun& d = drops[i];
+      out << sample << ',' << i << ',' << int(d.impact) << ',' << int(d.flight) << ',' << d.flight_speed << ','
+          << d.flight_spin << ',' << d.bounces << ',' << d.travel << ',' << d.rest_time << ',' << int(d.time_limited)
+          << ',' << d.settle_onset << ',' << d.config << ',' << d.rest_height << ',' << d.responses << ',' << d.clamps
+          << '\n';
+    }
+  };
+  rows("reference", r.reference.drops);
+  rows("reference_b", r.reference_b.drops);
+  for (const MethodResult& m : r.methods) rows(m.name, m.drops);
+  return out.str();
+}
+
 std::string fidelity_json(const FidelityResult& r)
 {
   const int configs = static_cast<int>(r.pose_labels.size());
@@ -649,6 +670,10 @@ void register_fidelity_commands(CLI::App& app)
       ->capture_default_str();
   cmd->add_option("--meshes", opts->meshes_dir, "directory of the meshes (default: the source tree's tools/meshes)");
   cmd->add_option("--json", *json_path, "write the results as JSON");
+  auto drops_csv_path = std::make_shared<std::string>();
+  cmd->add_option("--drops-csv", *drops_csv_path,
+                  "write every single drop of every sample as a CSV row (sample, run, first flight's |v+| and |w+|, "
+                  "rises, travel, time to rest, rest configuration and height, ...), the distances' raw data");
   cmd->add_option("--chart", *chart_path,
                   "FILE.png (and FILE.svg): summary error against time per step (log x), Pareto front, noise floor");
   cmd->add_option("--metric-charts", *charts_dir, "directory: one chart per distance (PNG and SVG)");
@@ -674,6 +699,8 @@ void register_fidelity_commands(CLI::App& app)
     }
     try {
       const Charts charts{*chart_path, *bytes_chart_path, *charts_dir};
+      if (!drops_csv_path->empty() && (!replot->empty() || !convergence_json_path->empty()))
+        throw std::invalid_argument("--drops-csv needs a run: --replot and --convergence-json only print or draw");
       if (!replot->empty()) {
         // Redraw the charts of an earlier run from its JSON, without running anything.
         if (!charts.any()) throw std::invalid_argument("--replot needs --chart, --chart-bytes or --metric-charts");
@@ -693,6 +720,11 @@ void register_fidelity_commands(CLI::App& app)
       validate(o);
       // Fail on unwritable outputs before the run, not after it.
       if (!json_path->empty()) ensure_writable_directory(std::filesystem::absolute(*json_path).parent_path());
+      if (!drops_csv_path->empty()) {
+        if (!o.drops) throw std::invalid_argument("--drops-csv needs the single drops (no --scenes-only)");
+        if (!o.convergence.empty()) throw std::invalid_argument("--drops-csv: --convergence runs no single drops");
+        ensure_writable_directory(std::filesystem::absolute(*drops_csv_path).parent_path());
+      }
       if (!chart_path->empty()) ensure_writable_directory(std::filesystem::absolute(*chart_path).parent_path());
       if (!charts_dir->empty()) ensure_writable_directory(*charts_dir);
       if (!o.scene_frames.empty()) ensure_writable_directory(o.scene_frames);
@@ -711,6 +743,7 @@ void register_fidelity_commands(CLI::App& app)
       r.command = command_line(o);
       std::cout << fidelity_table(r) << std::flush;
       if (!json_path->empty()) write_file_atomic(*json_path, fidelity_json(r));
+      if (!drops_csv_path->empty()) write_file_atomic(*drops_csv_path, drops_csv(r));
       if (charts.any()) write_charts(r, charts);
     } catch (const std::exception& e) {
       std::cerr << "statsim fidelity: error: " << e.what() << "\n";
