@@ -607,8 +607,18 @@ TEST_CASE("fidelity: --drops-csv holds every drop of every sample, and the dista
     std::vector<std::string> f;
     std::stringstream cells(line);
     for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
-    REQUIRE(f.size() == 15);
+    REQUIRE(f.size() == 17);
     CHECK(std::stoi(f[1]) == rows[f[0]]);  // runs in order
+    if (f[2] == "1") {
+      // The approach before the first contact: a fall of 0.2 m to 1.0 m + 2 R from rest vertically,
+      // horizontal speed up to 0.5 m/s a component, read up to two steps early; the cube's spin
+      // keeps its drawn length (up to 5 rad/s a component) in free flight.
+      const double g = 9.81, dt = 1.0 / 120, R = std::sqrt(3.0) * 0.1;
+      CHECK(std::stod(f[15]) >= std::sqrt(2 * g * 0.2) - 2 * g * dt);
+      CHECK(std::stod(f[15]) <= std::sqrt(0.5 + 2 * g * (1.0 + 2 * R)));
+      CHECK(std::stod(f[16]) > 0);
+      CHECK(std::stod(f[16]) <= 5 * std::sqrt(3.0) + 1e-9);
+    }
     ++rows[f[0]];
     speed[f[0]].push_back(f[3] == "1" ? std::stod(f[4]) : -1.0);
     travel[f[0]].push_back(std::stod(f[7]));

@@ -934,6 +934,43 @@ TEST_CASE("gather3d: a response trial's spin by gyration carries its rotational 
   }
 }
 
+TEST_CASE("gather3d: with --response-flight a response trial ends at the first flight that rises landing_hop L")
+{
+  GatherOptions plain;
+  plain.box_size = {0.2, 0.2, 0.2};
+  GatherOptions flight = plain;
+  flight.response_flight = true;
+  const ShapeModel m = build_model(plain);
+  const Reference ref(m, plain.reference);
+  const double L = m.bounding_radius, speed = 3.5, g = plain.reference.gravity, hop = flight.landing_hop * L;
+  int flown = 0, plain_low = 0;
+  for (std::uint64_t i = 0; i < 24; ++i) {
+    CAPTURE(i);
+    const ResponseTrial f = response_trial(ref, flight, 1.0, 0.5, speed, 0.25, kResponseStream, i, false);
+    const ResponseTrial p = response_trial(ref, plain, 1.0, 0.5, speed, 0.25, kResponseStream, i, false);
+    CHECK(f.contact.velocity == p.contact.velocity);  // the same start
+    CHECK_FALSE(p.no_flight);
+    const double vz = p.departure.velocity.z();
+    if (vz * vz / (2 * g) < hop) ++plain_low;  // a separation the drop would not count as a flight
+    if (f.no_flight) {
+      CHECK(f.value == p.value);  // the gravity-free outcome kept
+      continue;
+    }
+    ++flown;
+    // Left for a flight under gravity whose centre rises at least hop: v_z^2 / (2 g) >= hop.
+    const double fz = f.departure.velocity.z();
+    CHECK(fz > 0);
+    CHECK(fz * fz / (2 * g) >= hop);
+    CHECK(f.value[5] * speed == doctest::Approx(fz - p.contact.velocity.z() * -flight.reference.restitution).epsilon(1e-6));
+  }
+  // Both kinds occur here, so the checks above tell the two trials apart.
+  CHECK(flown > 0);
+  CHECK(plain_low > 0);
+
+  TempDir dir("gather3d_flight");
+  check_refused(dir, {"--response-flight", "--no-landing"}, "--response-flight needs the landing data");
+}
+
 TEST_CASE("gather3d: a response trial by energy meets the ground at its cell's spin ratio by energy")
 {
   GatherOptions o;

@@ -10,8 +10,9 @@ FlightTop::FlightTop(double dt, double min_rise, double gravity) : dt_(dt), min_
 void FlightTop::add(const Eigen::Vector3d& velocity, const Eigen::Vector3d& spin)
 {
   ++steps_;
-  const Eigen::Vector3d prev = prev_v_;
+  const Eigen::Vector3d prev = prev_v_, prev_w = prev_w_;
   prev_v_ = velocity;
+  prev_w_ = spin;
   if (steps_ == 0 || found_) return;
   const double g_dt = gravity_ * dt_;
   // Over a free step v_k = v_(k-1) - g dt e_z; what is left is the impulse of the contacts over
@@ -20,6 +21,8 @@ void FlightTop::add(const Eigen::Vector3d& velocity, const Eigen::Vector3d& spin
   if (contact_step_ < 0) {
     if (velocity.z() - prev.z() <= 2 * g_dt) return;
     contact_step_ = steps_;
+    impact_speed_ = prev.norm();
+    impact_spin_ = prev_w.norm();
   }
   if (kick.norm() > kFreeTolerance * g_dt) {
     // Whatever the step, the velocity after the last step with a contact is the one the body

@@ -44,14 +44,22 @@ public:
   double speed() const { return speed_; }              ///< m/s, |v| as the body left for that flight
   double spin() const { return spin_; }                ///< rad/s, |w| as the body left for that flight
   double rise() const { return rise_; }                ///< m, the rise of that flight, v_z^2 / (2 g)
+  /// m/s and rad/s, the velocity and spin the body left for that flight with (valid when found())
+  const Eigen::Vector3d& leave_velocity() const { return leave_v_; }
+  const Eigen::Vector3d& leave_spin() const { return leave_w_; }
+  /// m/s, |v| before the step of the first contact (the approach speed |V-|); 0 before a contact
+  double impact_speed() const { return impact_speed_; }
+  /// rad/s, |w| before the step of the first contact; 0 before a contact
+  double impact_spin() const { return impact_spin_; }
 
 private:
   double dt_, min_rise_, gravity_;
   long steps_ = -1;
   long contact_step_ = -1;
   bool found_ = false;
-  double speed_ = 0, spin_ = 0, rise_ = 0;
+  double speed_ = 0, spin_ = 0, rise_ = 0, impact_speed_ = 0, impact_spin_ = 0;
   Eigen::Vector3d prev_v_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d prev_w_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d leave_v_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d leave_w_ = Eigen::Vector3d::Zero();
 };

@@ -115,6 +115,8 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
   out.flight = top.found();
   out.flight_speed = top.speed();
   out.flight_spin = top.spin();
+  out.impact_speed = top.impact_speed();
+  out.impact_spin = top.impact_spin();
   out.responses = sim->statistical_responses();
   out.clamps = sim->energy_clamps();
   out.time_limited = !rested;

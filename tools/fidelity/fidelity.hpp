@@ -110,6 +110,8 @@ struct DropRun {
   bool flight = false;         ///< a flight after the first contact was found (FlightTop::found)
   double flight_speed = 0;     ///< m/s, |v| as the body left for that flight (FlightTop)
   double flight_spin = 0;      ///< rad/s, |w| as the body left for that flight
+  double impact_speed = 0;     ///< m/s, |v| before the first contact's step (|V-|; FlightTop)
+  double impact_spin = 0;      ///< rad/s, |w| before the first contact's step
   std::uint64_t responses = 0; ///< statsim: sampled responses applied (World::statistical_response_count)
   std::uint64_t clamps = 0;    ///< statsim: of those, scaled down by the energy guard
 };

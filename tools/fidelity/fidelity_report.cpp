@@ -294,14 +294,14 @@ std::string drops_csv(const FidelityResult& r)
   std::ostringstream out;
   out.precision(17);
   out << "sample,run,impact,flight,flight_speed,flight_spin,bounces,travel,rest_time,time_limited,settle_onset,config,"
-         "rest_height,responses,clamps\n";
+         "rest_height,responses,clamps,impact_speed,impact_spin\n";
   const auto rows = [&out](const std::string& sample, const std::vector<DropRun>& drops) {
     for (std::size_t i = 0; i < drops.size(); ++i) {
       const DropRun& d = drops[i];
       out << sample << ',' << i << ',' << int(d.impact) << ',' << int(d.flight) << ',' << d.flight_speed << ','
           << d.flight_spin << ',' << d.bounces << ',' << d.travel << ',' << d.rest_time << ',' << int(d.time_limited)
           << ',' << d.settle_onset << ',' << d.config << ',' << d.rest_height << ',' << d.responses << ',' << d.clamps
-          << '\n';
+          << ',' << d.impact_speed << ',' << d.impact_spin << '\n';
     }
   };
   rows("reference", r.reference.drops);

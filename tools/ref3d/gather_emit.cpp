@@ -76,7 +76,8 @@ std::vector<std::string> option_lines(const GatherResult& r)
   std::vector<std::string> l;
   l.push_back("layout " + std::string(o.with_speed ? "with_speed (cos theta, cos phi, |V-|, spin ratio)"
                                                      : "scaled (cos theta, cos phi, spin ratio)") +
-              (o.with_speed ? "" : ", impacts at |V-| = " + num(o.speed) + " m/s") + "; precision " +
+              (o.with_speed ? "" : ", impacts at |V-| = " + num(o.speed) + " m/s") +
+              (o.response_flight ? ", each to the first flight rising " + num(o.landing_hop) + " L under gravity" : "") + "; precision " +
               (o.i16 ? "i16" : "f32") + "; seed " + std::to_string(o.seed) + "; response model " +
               response_model_name(o.response_model) +
               (o.response_model == ResponseModel::empirical
@@ -144,7 +145,9 @@ std::string header_text(const GatherResult& r, const std::string& command)
   const long long flights = r.height_flights > 0 ? r.height_flights
                                                  : static_cast<long long>(r.height_mean.size()) * o.height_trials;
   h << "// Trials: " << flights << " flights, "
-    << r.response_trials << " impacts (" << r.time_limited << " hit the time limit), " << o.rest_drops
+    << r.response_trials << " impacts (" << r.time_limited << " hit the time limit"
+    << (o.response_flight ? ", " + std::to_string(r.no_flight) + " not flown off: gravity-free outcome" : std::string())
+    << "), " << o.rest_drops
     << " rest drops (" << r.unsettled << " did not settle)\n";
   h << "// Rest poses (body-frame up, height, frequency, family):";
   for (const RestPose& p : r.rest)
@@ -368,6 +371,7 @@ std::string json_text(const GatherResult& r, const std::string& command)
                {"trials", r.response_trials},
                {"time_limited", r.time_limited},
                {"max_penetration", r.max_penetration}};
+  if (o.response_flight) resp["to_first_flight"] = {{"hop", o.landing_hop}, {"no_flight", r.no_flight}};
   if (o.i16) {
     const Quantized qm = quantize(to_float(r.response_mean)), qs = quantize(to_float(spread));
     resp["i16"] = {{"mean_scale", static_cast<double>(qm.scale)},
@@ -470,7 +474,8 @@ std::string summary_text(const GatherResult& r)
   s << "h_coll: " << fmt("%.5f", r.height_mean.front()) << " m at s = " << num(r.options.height_ratios.front()) << " to "
     << fmt("%.5f", r.height_mean.back()) << " m at s = " << num(r.options.height_ratios.back()) << " ("
     << fmt("%.1f", r.height_seconds) << " s)\n";
-  s << "responses: " << r.response_trials << " impacts, " << r.time_limited << " time-limited, deepest penetration "
+  s << "responses: " << r.response_trials << " impacts, " << r.time_limited << " time-limited, "
+    << (r.options.response_flight ? std::to_string(r.no_flight) + " not flown off, " : std::string()) << "deepest penetration "
     << fmt("%.3g", r.max_penetration) << " m (" << fmt("%.1f", r.response_seconds) << " s)\n";
   s << "rest: " << r.settled << " settled (mean " << fmt("%.2f", r.mean_settle_time) << " s), " << r.unsettled << " unsettled; " << r.rest.size() << " poses kept, "
     << r.rest_rare.size() << " dropped (" << fmt("%.3f", r.rest_dropped) << " of the settled drops); "

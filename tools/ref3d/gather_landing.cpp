@@ -1,7 +1,6 @@
 // See gather_landing.hpp.
 #include "ref3d/gather_landing.hpp"
 
-#include "common/flight_top.hpp"
 #include "common/parallel.hpp"
 #include "common/pi.hpp"
 #include "common/progress.hpp"
@@ -49,20 +48,7 @@ LandingTrial landing_trial(const Reference& ref, const GatherOptions& o, const S
 
   const double hop = o.landing_hop * L;
   LandingTrial out;
-  {
-    const std::unique_ptr<Reference::Run> run = ref.run(start);
-    const double dt = ref.settings().dt;
-    FlightTop top(dt, hop, g);
-    top.add(start.velocity, start.spin);
-    const long steps = static_cast<long>(std::ceil(o.landing_time / dt));
-    for (long k = 0; k < steps && !top.found(); ++k) {
-      run->step();
-      const RigidState s = run->state();
-      top.add(s.velocity, s.spin);
-      if (k > 0 && s.velocity.norm() < o.still_speed && s.spin.norm() * L < o.still_speed) break;  // at rest
-    }
-    out.stayed = !top.found();
-  }
+  out.stayed = !first_flight(ref, o, start, hop).found;
 
   // The runtime's draws at this contact: the sampled response's rise v_z^2 / (2 g) below `hop`.
   const Vector3 n(0, 0, 1);

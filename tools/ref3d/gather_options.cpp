@@ -101,6 +101,9 @@ void validate_gather_options(const GatherOptions& o)
   axis(o.cos_phi, "cos phi axis", -1, 1);
   axis(o.spin_ratios, "spin ratio axis", 0, 1e6);
   if (o.with_speed && !o.speeds.empty()) axis(o.speeds, "speed axis", 1e-3, 1e3);
+  if (o.response_flight && !(o.landing && o.body_contacts))
+    fail("--response-flight needs the landing data, which draws again or keeps the stays its trials leave out "
+         "(drop --no-landing and --no-body-contacts)");
   if (o.landing) {
     if (o.landing_trials < 1) fail("--landing-trials must be at least 1");
     axis(o.landing_froude, "--landing-froude axis", 0, 1e6);

@@ -77,6 +77,10 @@ struct GatherOptions {
   std::vector<double> landing_froude = default_landing_froude();
   double landing_hop = 0.05;         ///< rise over L below which an impact counts as a stay
   double landing_time = 1.0;         ///< s: an impact not flown off by then counts as a stay
+  /// Response trials under gravity, each to the first flight whose centre rises landing_hop L
+  /// (the chain of contacts a drop's first flight ends), as `statsim fidelity` measures a drop's
+  /// first impact; a trial with no such flight within landing_time keeps the gravity-free outcome.
+  bool response_flight = false;
   // Settling data (6., statsim/signature_settle.hpp, gather_settle.hpp): a table of format 2.3,
   // when asked for (--settle) and with the landing data it follows in a table.
   bool settle = false;

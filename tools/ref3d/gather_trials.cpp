@@ -1,6 +1,7 @@
 // See gather_trials.hpp.
 #include "ref3d/gather_trials.hpp"
 
+#include "common/flight_top.hpp"
 #include "common/pi.hpp"
 #include "ref3d/sampling.hpp"
 #include "statsim/detail/response.hpp"
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace statsim::tools::ref3d {
 
@@ -25,6 +27,29 @@ double height_trial(const ShapeModel& m, double spin_ratio, std::uint64_t seed, 
   const FirstContact fc = first_contact(m.hull, L, flight, s, 0.0, std::numeric_limits<double>::infinity(),
                                         1e-12 * L, 100000000);
   return fc.state.position.z() - lowest_point(m.hull, fc.state);
+}
+
+FirstFlight first_flight(const Reference& ref, const GatherOptions& o, const RigidState& start, double hop)
+{
+  const double L = ref.model().bounding_radius;
+  const std::unique_ptr<Reference::Run> run = ref.run(start);
+  const double dt = ref.settings().dt;
+  FlightTop top(dt, hop, o.reference.gravity);
+  top.add(start.velocity, start.spin);
+  RigidState s = start;
+  const long steps = static_cast<long>(std::ceil(o.landing_time / dt));
+  for (long k = 0; k < steps && !top.found(); ++k) {
+    run->step();
+    s = run->state();
+    top.add(s.velocity, s.spin);
+    if (k > 0 && s.velocity.norm() < o.still_speed && s.spin.norm() * L < o.still_speed) break;  // at rest
+  }
+  FirstFlight f;
+  f.found = top.found();
+  f.velocity = top.leave_velocity();
+  f.spin = top.leave_spin();
+  f.orientation = s.orientation;
+  return f;
 }
 
 Eigen::Vector3d trial_spin(const ShapeModel& m, const Eigen::Quaterniond& orientation, const Eigen::Vector3d& axis,
@@ -61,7 +86,21 @@ ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, doubl
                                         1e-12 * L, 100000000);
   RigidState start = fc.state;
   start.position.z() -= 1e-6 * L;  // a hair into the ground, so that Bullet's first step has the contact
-  const ImpactResult ir = ref.impact(start, o.max_impact_time);
+  ImpactResult ir = ref.impact(start, o.max_impact_time);
+  bool no_flight = false;
+  if (o.response_flight) {
+    // The same start under gravity, to the first flight that rises landing_hop L: where a corner's
+    // hop lands again before the body flies, the drop's first flight ends the whole chain, and the
+    // runtime's sphere, which cannot hop on corners, takes it as one response.
+    const FirstFlight f = first_flight(ref, o, start, o.landing_hop * L);
+    if (f.found) {
+      ir.after.velocity = f.velocity;
+      ir.after.spin = f.spin;
+      ir.after.orientation = f.orientation;  // at the flight's top: K's orientation changes little in flight
+    } else {
+      no_flight = true;
+    }
+  }
 
   const Material mat{static_cast<Scalar>(o.reference.restitution), static_cast<Scalar>(o.reference.friction),
                      static_cast<Scalar>(o.rolling_resistance)};
@@ -81,6 +120,7 @@ ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, doubl
   out.contact = start;
   out.departure = ir.after;
   out.time_limited = ir.time_limited;
+  out.no_flight = no_flight;
   out.max_penetration = ir.max_penetration;
   out.steps = ir.steps;
   return out;

@@ -25,9 +25,24 @@ struct ResponseTrial {
   RigidState contact;   ///< the body as it met the ground: where the runtime's draws start (gather_spin.hpp)
   RigidState departure; ///< the body as it left the ground (W+ and V+; its orientation is K's in `gyration`)
   bool time_limited = false;
+  /// GatherOptions::response_flight: no flight rising landing_hop L within landing_time (the
+  /// outcome is then the gravity-free impact's)
+  bool no_flight = false;
   double max_penetration = 0.0;
   int steps = 0;
 };
+/// How a body left the ground under gravity (`first_flight`).
+struct FirstFlight {
+  bool found = false;                              ///< it flew: its centre rose hop at least
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, as it left for that flight
+  Eigen::Vector3d spin = Eigen::Vector3d::Zero();      ///< rad/s, as it left for that flight
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< at the run's last step
+};
+/// Runs `start` in Bullet with gravity until its first flight whose centre rises `hop` (m;
+/// common/flight_top.hpp, as `statsim fidelity` finds a drop's), until it is at rest (centre and
+/// farthest point by spin below `o.still_speed`) or for `o.landing_time`.
+FirstFlight first_flight(const Reference& ref, const GatherOptions& o, const RigidState& start, double hop);
+
 /// The spin a trial meets the ground with at spin ratio `spin_ratio` and speed |V-| `speed`
 /// (m/s), about the world-frame unit axis `axis`, for a body at orientation `orientation`:
 /// |W-| = spin_ratio |V-| / L, or with `by_energy` (statsim::ResponseSpin::energy) the |W-| that

@@ -429,6 +429,10 @@ void add_gather(CLI::App& app, std::ostream* out, std::ostream* err)
       ->capture_default_str();
   sub->add_option("--landing-time", o.landing_time, "Landing: s after which an impact not flown off counts as a stay")
       ->capture_default_str();
+  sub->add_flag("--response-flight", o.response_flight,
+                "Response trials under gravity, each to the first flight that rises --landing-hop L (the chain of "
+                "contacts a drop's first flight ends); a trial not flown off within --landing-time keeps the "
+                "gravity-free outcome");
   sub->add_flag("--settle", c->settle,
                 "Add the settling data (a table of format 2.3; needs the landing data): per rest pose, quantiles "
                 "of the time a rest drop took from its last moment at --settle-speed to staying below "

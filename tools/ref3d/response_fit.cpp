@@ -40,6 +40,7 @@ ResponseFit fit_responses(const std::vector<ResponseTrial>& all, std::size_t tri
   }
   for (const ResponseTrial& t : all) {
     f.time_limited += t.time_limited ? 1 : 0;
+    f.no_flight += t.no_flight ? 1 : 0;
     f.max_penetration = std::max(f.max_penetration, t.max_penetration);
   }
   f.response_trials = static_cast<long long>(all.size());

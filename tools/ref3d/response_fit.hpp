@@ -21,6 +21,7 @@ struct ResponseFit {
   std::vector<std::vector<Response>> cell_outcomes;
   long long response_trials = 0;
   long long time_limited = 0;
+  long long no_flight = 0;  ///< GatherOptions::response_flight: trials not flown off (ResponseTrial::no_flight)
   double max_penetration = 0.0;
 };
 
