@@ -291,6 +291,11 @@ TEST_CASE("fidelity: a collision of several strikes gives the same leaving state
     CHECK(top.speed() == v2.norm());
     CHECK(top.spin() == w2.norm());
     CHECK(top.rise() == doctest::Approx(1.2 * 1.2 / (2 * 9.81)));
+    // The leaving state, and the add() whose state it is (first_flight keeps that step's orientation).
+    CHECK(top.leave_velocity() == v2);
+    CHECK(top.leave_spin() == w2);
+    REQUIRE(top.leave_step() >= 0);
+    CHECK(tr[static_cast<std::size_t>(top.leave_step())].first == v2);
     old.push_back(old_first_impact(tr, dt));
   }
   // What was measured before: the state after the first strike at 1 ms (less a step of

@@ -29,6 +29,7 @@ void FlightTop::add(const Eigen::Vector3d& velocity, const Eigen::Vector3d& spin
     // leaves with: engines apply gravity before they solve the contacts.
     leave_v_ = velocity;
     leave_w_ = spin;
+    leave_step_ = steps_;
     return;
   }
   // The top of a free flight: from there the body left with leave_v_, and its centre rose

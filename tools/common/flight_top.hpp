@@ -47,6 +47,8 @@ public:
   /// m/s and rad/s, the velocity and spin the body left for that flight with (valid when found())
   const Eigen::Vector3d& leave_velocity() const { return leave_v_; }
   const Eigen::Vector3d& leave_spin() const { return leave_w_; }
+  /// The add() call (0 = the initial state) whose state is the one the body leaves with so far
+  long leave_step() const { return leave_step_; }
   /// m/s, |v| before the step of the first contact (the approach speed |V-|); 0 before a contact
   double impact_speed() const { return impact_speed_; }
   /// rad/s, |w| before the step of the first contact; 0 before a contact
@@ -56,6 +58,7 @@ private:
   double dt_, min_rise_, gravity_;
   long steps_ = -1;
   long contact_step_ = -1;
+  long leave_step_ = -1;
   bool found_ = false;
   double speed_ = 0, spin_ = 0, rise_ = 0, impact_speed_ = 0, impact_spin_ = 0;
   Eigen::Vector3d prev_v_ = Eigen::Vector3d::Zero();

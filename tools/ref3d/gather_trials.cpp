@@ -36,19 +36,19 @@ FirstFlight first_flight(const Reference& ref, const GatherOptions& o, const Rig
   const double dt = ref.settings().dt;
   FlightTop top(dt, hop, o.reference.gravity);
   top.add(start.velocity, start.spin);
-  RigidState s = start;
+  FirstFlight f;
+  f.orientation = start.orientation;
   const long steps = static_cast<long>(std::ceil(o.landing_time / dt));
   for (long k = 0; k < steps && !top.found(); ++k) {
     run->step();
-    s = run->state();
+    const RigidState s = run->state();
     top.add(s.velocity, s.spin);
+    if (top.leave_step() == k + 1) f.orientation = s.orientation;  // the state it leaves with, so far
     if (k > 0 && s.velocity.norm() < o.still_speed && s.spin.norm() * L < o.still_speed) break;  // at rest
   }
-  FirstFlight f;
   f.found = top.found();
   f.velocity = top.leave_velocity();
   f.spin = top.leave_spin();
-  f.orientation = s.orientation;
   return f;
 }
 
@@ -96,7 +96,7 @@ ResponseTrial response_trial(const Reference& ref, const GatherOptions& o, doubl
     if (f.found) {
       ir.after.velocity = f.velocity;
       ir.after.spin = f.spin;
-      ir.after.orientation = f.orientation;  // at the flight's top: K's orientation changes little in flight
+      ir.after.orientation = f.orientation;  // as it left: K's, as for the gravity-free trials
     } else {
       no_flight = true;
     }

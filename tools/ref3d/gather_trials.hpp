@@ -36,7 +36,7 @@ struct FirstFlight {
   bool found = false;                              ///< it flew: its centre rose hop at least
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, as it left for that flight
   Eigen::Vector3d spin = Eigen::Vector3d::Zero();      ///< rad/s, as it left for that flight
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< at the run's last step
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< as it left for that flight
 };
 /// Runs `start` in Bullet with gravity until its first flight whose centre rises `hop` (m;
 /// common/flight_top.hpp, as `statsim fidelity` finds a drop's), until it is at rest (centre and
