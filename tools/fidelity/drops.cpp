@@ -52,7 +52,8 @@ double speed(const scenes::BodyState3& s, double radius)
   return std::max(s.linear_velocity.norm(), s.angular_velocity.norm() * radius);
 }
 
-DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream, double dt, double limit)
+DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream, double dt, double limit,
+                   std::uint64_t world_seed)
 {
   const double R = setup.radius;
   scenes::DropScene3 scene;
@@ -61,7 +62,7 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
   scene.bodies.push_back(drop_state(stream, R));
   scene.bounds_lo = Eigen::Vector3d(-50, -50, -1);
   scene.bounds_hi = Eigen::Vector3d(50, 50, 10);
-  std::unique_ptr<bench::Sim> sim = build(setup, m, scene, stream, dt);
+  std::unique_ptr<bench::Sim> sim = build(setup, m, scene, world_seed, dt);
 
   DropRun out;
   const scenes::BodyState3 start = scene.bodies[0];

@@ -205,7 +205,9 @@ FidelityResult run_fidelity(const FidelityOptions& options)
           const MethodSpec& m = sample < 2 ? ref : setup->methods[sample - 2];
           const double dt = sample < 2 ? options.reference_dt : options.dt;
           const std::uint64_t index = r + (sample == 1 ? kSampleB : 0);
-          return run_single(*setup, m, mix(options.seed, index), dt, options.time_limit);
+          const std::uint64_t stream = mix(options.seed, index);
+          const std::uint64_t world = options.draw_seed == 0 ? stream : mix(options.draw_seed, stream);
+          return run_single(*setup, m, stream, dt, options.time_limit, world);
         },
         [](MethodResult& mr, const DropRun& d) { mr.drops.push_back(d); });
   }

@@ -52,6 +52,10 @@ struct FidelityOptions {
   int bench_steps = 300;             ///< steps of the step-time scene
   bool timing = true;                ///< measure step_ms
   std::uint64_t seed = 1;            ///< of the single-drop streams and the statsim worlds
+  /// 0: a single drop's statsim world is seeded by the drop's stream. Otherwise by a mix of this
+  /// and the stream: the same drops with other draws of the tables, so a rerun shows how far
+  /// statsim's own sampling moves a figure (the references' drops are unchanged).
+  std::uint64_t draw_seed = 0;
   unsigned threads = 0;              ///< 0: every core
   int bootstrap = 200;               ///< resamples per interval
   std::string meshes_dir;            ///< empty: the source tree's tools/meshes

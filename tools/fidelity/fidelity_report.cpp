@@ -261,7 +261,9 @@ std::string command_line(const FidelityOptions& o)
     if (!o.mix.empty()) c << " --mix " << o.mix;
     if (!o.scene_reference.empty()) c << " --scene-reference " << o.scene_reference;
   }
-  c << " --seed " << o.seed << " --bootstrap " << o.bootstrap;
+  c << " --seed " << o.seed;
+  if (o.draw_seed != 0) c << " --draw-seed " << o.draw_seed;
+  c << " --bootstrap " << o.bootstrap;
   return c.str();
 }
 
@@ -333,6 +335,7 @@ std::string fidelity_json(const FidelityResult& r)
                   {"bench_n", r.options.bench_n},
                   {"bench_steps", r.options.bench_steps},
                   {"seed", r.options.seed},
+                  {"draw_seed", r.options.draw_seed},
                   {"bootstrap", r.options.bootstrap},
                   {"drops", r.options.drops},
                   {"scenes", r.options.scenes},
@@ -665,6 +668,10 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--bench-steps", opts->bench_steps, "steps of the step-time scene")->capture_default_str();
   cmd->add_flag("--no-timing", *no_timing, "do not measure step_ms");
   cmd->add_option("--seed", opts->seed, "seed of the single-drop streams")->capture_default_str();
+  cmd->add_option("--draw-seed", opts->draw_seed,
+                  "0: each statsim world of a single drop seeded by the drop's stream; else the same drops with "
+                  "other draws of the tables (how far statsim's own sampling moves a figure)")
+      ->capture_default_str();
   cmd->add_option("--bootstrap", opts->bootstrap, "bootstrap resamples per interval")->capture_default_str();
   cmd->add_option("--threads", opts->threads, "worker threads (0: every core); results do not depend on it")
       ->capture_default_str();

@@ -77,8 +77,10 @@ int classify(const Eigen::Quaterniond& q, const SignatureView<3>& sig);
 /// max(|v|, |w| R) of a body state.
 double speed(const scenes::BodyState3& s, double radius);
 
-/// Single drop `stream` of method `m` at `dt`, up to `limit` s.
-DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream, double dt, double limit);
+/// Single drop `stream` of method `m` at `dt`, up to `limit` s; a statsim method's world is
+/// seeded with `world_seed`.
+DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream, double dt, double limit,
+                   std::uint64_t world_seed);
 /// The drop pile of `seed` of method `m`.
 PileRun run_pile(const Setup& setup, const MethodSpec& m, std::uint64_t seed, int count, double dt, double limit,
                  std::uint64_t world_seed);
