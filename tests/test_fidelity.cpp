@@ -676,6 +676,58 @@ TEST_CASE("fidelity: --draw-seed draws statsim's tables again on the same drops,
   CHECK(differ > 0);
 }
 
+TEST_CASE("fidelity: --profile-csv is the drops' mean motion against time, rested drops counting zero")
+{
+  TempDir dir("fidelity");
+  const std::string profile = dir.file("profile.csv"), drops = dir.file("drops.csv");
+  const double limit = 4.0;
+  REQUIRE(run_cli({"--shape", "box", "--runs", "8", "--no-piles", "--no-timing", "--methods", "statistical", "--dt",
+                   "1/120", "--reference-dt", "1/120", "--reference", "bench", "--bootstrap", "0", "--threads", "2",
+                   "--time-limit", "4", "--profile-csv", profile, "--drops-csv", drops, "--quiet"}) == 0);
+  // Per sample, the share of its drops still moving at the limit (time_limited), from --drops-csv.
+  std::map<std::string, double> limited;
+  {
+    std::istringstream in(read_file(drops));
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::vector<std::string> f;
+      std::stringstream cells(line);
+      for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
+      limited[f[0]] += std::stod(f[9]) / 8.0;
+    }
+  }
+  std::istringstream in(read_file(profile));
+  std::string line;
+  REQUIRE(std::getline(in, line));
+  CHECK(line == "sample,t,moving,speed,spin_speed,height_above_rest");
+  std::map<std::string, std::vector<std::vector<double>>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> f;
+    std::stringstream cells(line);
+    std::string sample, c;
+    std::getline(cells, sample, ',');
+    while (std::getline(cells, c, ',')) f.push_back(std::stod(c));
+    REQUIRE(f.size() == 5);
+    rows[sample].push_back(f);
+  }
+  REQUIRE(rows.size() == 3);
+  for (const auto& [sample, r] : rows) {
+    CAPTURE(sample);
+    REQUIRE(r.size() == 80);  // 4 s in steps of 0.05 s
+    // At 0.05 s every drop is still falling: from 0.2 m to 1.0 m above its radius, at rest height at most R.
+    CHECK(r[0][1] == 1.0);
+    CHECK(r[0][4] >= 0.2 - 0.5 * 9.81 * 0.05 * 0.05 - 1e-6);
+    CHECK(r[0][2] > 0.3);  // falling for 0.05 s at least: g t, and up to 0.5 m/s across
+    for (std::size_t k = 0; k < r.size(); ++k) {
+      CHECK(r[k][0] == doctest::Approx(0.05 * double(k + 1)));
+      if (k > 0) CHECK(r[k][1] <= r[k - 1][1]);  // a drop at rest stays at rest
+      if (r[k][1] == 0.0) CHECK((r[k][2] == 0.0 && r[k][3] == 0.0 && r[k][4] == 0.0));
+    }
+    CHECK(r.back()[1] == doctest::Approx(limited[sample]));
+  }
+}
+
 TEST_CASE("fidelity convergence: a change within its floor converges, one past it does not")
 {
   // Two figures over four seeds at three levels. Level 0 to 1: the first figure moves by 1.0 where

@@ -81,6 +81,11 @@ DropRun run_single(const Setup& setup, const MethodSpec& m, std::uint64_t stream
     sim->step();
     t = static_cast<double>(k) * dt;
     s = sim->body_state(0);
+    while (t >= static_cast<double>(out.profile_speed.size() + 1) * kProfileStep - 1e-9) {
+      out.profile_speed.push_back(static_cast<float>(s.linear_velocity.norm()));
+      out.profile_spin.push_back(static_cast<float>(s.angular_velocity.norm() * R));
+      out.profile_height.push_back(static_cast<float>(s.position.z()));
+    }
     const bool contact = top.contact();
     top.add(s.linear_velocity, s.angular_velocity);
     if (!contact && top.contact()) low = s.position.z();

@@ -99,6 +99,9 @@ std::vector<std::string> default_methods();
 /// The end of a drop's first collision (`FlightTop`, common/flight_top.hpp).
 using statsim::tools::FlightTop;
 
+/// Interval of a single drop's motion profile (`DropRun::profile_speed`, `--profile-csv`), s.
+constexpr double kProfileStep = 0.05;
+
 /// Outcome of one single drop.
 struct DropRun {
   int config = -1;             ///< rest configuration: pose index, or the pose count for "other"
@@ -118,6 +121,9 @@ struct DropRun {
   double impact_spin = 0;      ///< rad/s, |w| before the first contact's step
   std::uint64_t responses = 0; ///< statsim: sampled responses applied (World::statistical_response_count)
   std::uint64_t clamps = 0;    ///< statsim: of those, scaled down by the energy guard
+  /// The motion every kProfileStep s, sample k at t = (k + 1) kProfileStep, until the drop rested
+  /// or the time limit: |v| (m/s), |w| R (m/s, the farthest point's speed by spin), centre height (m).
+  std::vector<float> profile_speed, profile_spin, profile_height;
 };
 
 /// Final state of one pile.
@@ -251,6 +257,11 @@ std::string fidelity_json(const FidelityResult& result);
 /// reference_b, or the method's name), the run's index, and the DropRun's fields, doubles written
 /// with 17 significant digits, so the distances can be recomputed from the file exactly.
 std::string drops_csv(const FidelityResult& result);
+/// The single drops' mean motion against time (`--profile-csv`), one row per sample and
+/// kProfileStep: t (s), the share of drops not yet at rest, and over every drop the mean |v|, |w| R
+/// (m/s) and centre height above the drop's final height (m), a drop at rest counting with 0, 0
+/// and 0. Where a statistical body loses its motion earlier than the reference, and how.
+std::string profile_csv(const FidelityResult& result, double time_limit);
 std::string fidelity_table(const FidelityResult& result);
 /// The scenes' tables (part of fidelity_table()).
 std::string scenes_table(const FidelityResult& result);

@@ -312,6 +312,33 @@ std::string drops_csv(const FidelityResult& r)
   return out.str();
 }
 
+std::string profile_csv(const FidelityResult& r, double time_limit)
+{
+  std::ostringstream out;
+  out.precision(9);
+  out << "sample,t,moving,speed,spin_speed,height_above_rest\n";
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(time_limit / kProfileStep - 1e-9));
+  const auto rows = [&](const std::string& sample, const std::vector<DropRun>& drops) {
+    for (std::size_t k = 0; k < bins; ++k) {
+      double moving = 0, speed = 0, spin = 0, height = 0;
+      for (const DropRun& d : drops) {
+        if (k >= d.profile_speed.size()) continue;  // at rest: 0 to every mean
+        moving += 1;
+        speed += d.profile_speed[k];
+        spin += d.profile_spin[k];
+        height += double(d.profile_height[k]) - double(d.profile_height.back());
+      }
+      const double n = drops.empty() ? 1.0 : static_cast<double>(drops.size());
+      out << sample << ',' << static_cast<double>(k + 1) * kProfileStep << ',' << moving / n << ',' << speed / n << ','
+          << spin / n << ',' << height / n << '\n';
+    }
+  };
+  rows("reference", r.reference.drops);
+  rows("reference_b", r.reference_b.drops);
+  for (const MethodResult& m : r.methods) rows(m.name, m.drops);
+  return out.str();
+}
+
 std::string fidelity_json(const FidelityResult& r)
 {
   const int configs = static_cast<int>(r.pose_labels.size());
@@ -681,6 +708,10 @@ void register_fidelity_commands(CLI::App& app)
   cmd->add_option("--drops-csv", *drops_csv_path,
                   "write every single drop of every sample as a CSV row (sample, run, first flight's |v+| and |w+|, "
                   "rises, travel, time to rest, rest configuration and height, ...), the distances' raw data");
+  auto profile_csv_path = std::make_shared<std::string>();
+  cmd->add_option("--profile-csv", *profile_csv_path,
+                  "write the single drops' mean motion against time, per sample every 0.05 s: share not yet at rest, "
+                  "mean |v|, |w| R and height above the final height (a drop at rest counts 0)");
   cmd->add_option("--chart", *chart_path,
                   "FILE.png (and FILE.svg): summary error against time per step (log x), Pareto front, noise floor");
   cmd->add_option("--metric-charts", *charts_dir, "directory: one chart per distance (PNG and SVG)");
@@ -706,8 +737,10 @@ void register_fidelity_commands(CLI::App& app)
     }
     try {
       const Charts charts{*chart_path, *bytes_chart_path, *charts_dir};
-      if (!drops_csv_path->empty() && (!replot->empty() || !convergence_json_path->empty()))
-        throw std::invalid_argument("--drops-csv needs a run: --replot and --convergence-json only print or draw");
+      for (const auto& [option, path] : {std::pair{"--drops-csv", drops_csv_path}, {"--profile-csv", profile_csv_path}})
+        if (!path->empty() && (!replot->empty() || !convergence_json_path->empty()))
+          throw std::invalid_argument(std::string(option) +
+                                      " needs a run: --replot and --convergence-json only print or draw");
       if (!replot->empty()) {
         // Redraw the charts of an earlier run from its JSON, without running anything.
         if (!charts.any()) throw std::invalid_argument("--replot needs --chart, --chart-bytes or --metric-charts");
@@ -727,10 +760,12 @@ void register_fidelity_commands(CLI::App& app)
       validate(o);
       // Fail on unwritable outputs before the run, not after it.
       if (!json_path->empty()) ensure_writable_directory(std::filesystem::absolute(*json_path).parent_path());
-      if (!drops_csv_path->empty()) {
-        if (!o.drops) throw std::invalid_argument("--drops-csv needs the single drops (no --scenes-only)");
-        if (!o.convergence.empty()) throw std::invalid_argument("--drops-csv: --convergence runs no single drops");
-        ensure_writable_directory(std::filesystem::absolute(*drops_csv_path).parent_path());
+      for (const auto& [option, path] : {std::pair{"--drops-csv", drops_csv_path}, {"--profile-csv", profile_csv_path}}) {
+        if (path->empty()) continue;
+        if (!o.drops) throw std::invalid_argument(std::string(option) + " needs the single drops (no --scenes-only)");
+        if (!o.convergence.empty())
+          throw std::invalid_argument(std::string(option) + ": --convergence runs no single drops");
+        ensure_writable_directory(std::filesystem::absolute(*path).parent_path());
       }
       if (!chart_path->empty()) ensure_writable_directory(std::filesystem::absolute(*chart_path).parent_path());
       if (!charts_dir->empty()) ensure_writable_directory(*charts_dir);
@@ -751,6 +786,7 @@ void register_fidelity_commands(CLI::App& app)
       std::cout << fidelity_table(r) << std::flush;
       if (!json_path->empty()) write_file_atomic(*json_path, fidelity_json(r));
       if (!drops_csv_path->empty()) write_file_atomic(*drops_csv_path, drops_csv(r));
+      if (!profile_csv_path->empty()) write_file_atomic(*profile_csv_path, profile_csv(r, o.time_limit));
       if (charts.any()) write_charts(r, charts);
     } catch (const std::exception& e) {
       std::cerr << "statsim fidelity: error: " << e.what() << "\n";
