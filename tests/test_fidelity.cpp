@@ -680,7 +680,6 @@ TEST_CASE("fidelity: --profile-csv is the drops' mean motion against time, reste
 {
   TempDir dir("fidelity");
   const std::string profile = dir.file("profile.csv"), drops = dir.file("drops.csv");
-  const double limit = 4.0;
   REQUIRE(run_cli({"--shape", "box", "--runs", "8", "--no-piles", "--no-timing", "--methods", "statistical", "--dt",
                    "1/120", "--reference-dt", "1/120", "--reference", "bench", "--bootstrap", "0", "--threads", "2",
                    "--time-limit", "4", "--profile-csv", profile, "--drops-csv", drops, "--quiet"}) == 0);
