@@ -7,6 +7,7 @@
 #include "ref3d/ref3d.hpp"
 #include "ref3d/signature_json.hpp"
 
+#include "support/csv.hpp"
 #include "support/table_header.hpp"
 #include "support/temp_dir.hpp"
 #include "tables/box.hpp"
@@ -690,9 +691,7 @@ TEST_CASE("fidelity: --profile-csv is the drops' mean motion against time, reste
     std::string line;
     std::getline(in, line);
     while (std::getline(in, line)) {
-      std::vector<std::string> f;
-      std::stringstream cells(line);
-      for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
+      const std::vector<std::string> f = csv_fields(line);
       limited[f[0]] += std::stod(f[9]) / 8.0;
     }
   }
@@ -702,13 +701,11 @@ TEST_CASE("fidelity: --profile-csv is the drops' mean motion against time, reste
   CHECK(line == "sample,t,moving,speed,spin_speed,height_above_rest");
   std::map<std::string, std::vector<std::vector<double>>> rows;
   while (std::getline(in, line)) {
+    const std::vector<std::string> fields = csv_fields(line);
+    REQUIRE(fields.size() == 6);
     std::vector<double> f;
-    std::stringstream cells(line);
-    std::string sample, c;
-    std::getline(cells, sample, ',');
-    while (std::getline(cells, c, ',')) f.push_back(std::stod(c));
-    REQUIRE(f.size() == 5);
-    rows[sample].push_back(f);
+    for (std::size_t i = 1; i < fields.size(); ++i) f.push_back(std::stod(fields[i]));
+    rows[fields[0]].push_back(f);
   }
   REQUIRE(rows.size() == 3);
   for (const auto& [sample, r] : rows) {

@@ -16,8 +16,10 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace statsim::tools::fidelity {
 namespace {
@@ -326,7 +328,7 @@ std::string profile_csv(const FidelityResult& r, double time_limit)
         moving += 1;
         speed += d.profile_speed[k];
         spin += d.profile_spin[k];
-        height += double(d.profile_height[k]) - double(d.profile_height.back());
+        height += double(d.profile_height[k]) - d.rest_height * r.bounding_radius;
       }
       const double n = drops.empty() ? 1.0 : static_cast<double>(drops.size());
       out << sample << ',' << static_cast<double>(k + 1) * kProfileStep << ',' << moving / n << ',' << speed / n << ','
@@ -737,7 +739,9 @@ void register_fidelity_commands(CLI::App& app)
     }
     try {
       const Charts charts{*chart_path, *bytes_chart_path, *charts_dir};
-      for (const auto& [option, path] : {std::pair{"--drops-csv", drops_csv_path}, {"--profile-csv", profile_csv_path}})
+      const std::pair<const char*, std::shared_ptr<std::string>> csv_outputs[] = {{"--drops-csv", drops_csv_path},
+                                                                                  {"--profile-csv", profile_csv_path}};
+      for (const auto& [option, path] : csv_outputs)
         if (!path->empty() && (!replot->empty() || !convergence_json_path->empty()))
           throw std::invalid_argument(std::string(option) +
                                       " needs a run: --replot and --convergence-json only print or draw");
@@ -760,7 +764,7 @@ void register_fidelity_commands(CLI::App& app)
       validate(o);
       // Fail on unwritable outputs before the run, not after it.
       if (!json_path->empty()) ensure_writable_directory(std::filesystem::absolute(*json_path).parent_path());
-      for (const auto& [option, path] : {std::pair{"--drops-csv", drops_csv_path}, {"--profile-csv", profile_csv_path}}) {
+      for (const auto& [option, path] : csv_outputs) {
         if (path->empty()) continue;
         if (!o.drops) throw std::invalid_argument(std::string(option) + " needs the single drops (no --scenes-only)");
         if (!o.convergence.empty())
