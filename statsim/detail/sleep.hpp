@@ -151,11 +151,15 @@ void fall_asleep(WorldData<D>& w, Body<D>& b, std::uint32_t i, bool posed, const
   if (b.rest_pose != no_rest_pose && b.on_ground && posed) {
     // Fall asleep exactly in the pose, at its height: the last few degrees and the rest of
     // the radius blend are below what a slow body would show. The centre stood `above` the
-    // ground: it ends at the pose's height above it.
+    // ground: it ends at the pose's height above it. Not lower, though, for a body near others
+    // whose blend has not run its course: it settled on them rather than on the ground (its
+    // sphere, still larger than the pose's height, reached the ground beside them), and the
+    // rest of the blend would put it into the body under it, where asleep nothing lifts it out.
     const SignatureView<D>& sig = w.shapes[b.shape].signature;
     b.orientation = snap_to_rest(b.orientation, sig.rest.normal(b.rest_pose), ground);
     const Scalar h = sig.rest.heights[b.rest_pose];
-    b.position += ground * (h - above);
+    const bool held = bit_set(w.paired, i) && b.rest_blend < 1;
+    if (!(held && h < above)) b.position += ground * (h - above);
     b.radius = h;
     b.rest_blend = 1;
   }
