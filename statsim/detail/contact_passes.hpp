@@ -71,8 +71,8 @@ void respond_alone(const WorldData<D>& w, StepContext<FS>& ctx, Body<D>& b, cons
   // from the strikes of its faces one after the other, each set by the last, which independent
   // samples of the tables' single-impact responses do not reproduce. A body that rolled through
   // the step in substeps (`roll_on_slopes`) has had its slope contacts there. On level ground
-  // the same holds for a body that was on the ground as the step began, or lands slower than
-  // its table's landing data measured (`ground_hull`, `slow_landing`): its tumbles and hops after
+  // the same holds for a body that was on the ground as the step began, or lands as slowly as a
+  // hop's landing (`ground_hull`, `slow_landing`): its tumbles and hops after
   // the first impact are its hull's.
   if ((tilted_plane || ground_contact) && rolls_on<FS>(w, b, n)) {
     if (!bit_set(w.rolled, std::uint32_t(&b - w.bodies)))

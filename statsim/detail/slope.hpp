@@ -85,29 +85,29 @@ bool ground_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D
   return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
 }
 
+/// The Froude number |v|^2 / (|g| L) below which a landing on level ground is a hop's
+/// (`slow_landing`): the centre fell from about L / 2 or less. A constant of the runtime, not the
+/// first Froude sample of a table's landing axis: with `--landing-froude 0,0.1,...` the box's hops
+/// landing between F = 0.1 and 1 drew fresh collisions, each another bounce (tools/fidelity/LOG.md,
+/// "The hops' landing at a fixed Froude number").
+constexpr Scalar hop_froude = 1;
+
 /// True when body `b`, statistical with landing data (`LandingView`), falls (its velocity has a
-/// part along gravity) slower than the slowest impact its landing data measured:
-/// |v|^2 < F_1 |g| L, F_1 the first Froude number above 0 on the landing axes, L the signature's
-/// length. A hop of a tumbling body ends in such a landing (from a rise of about F_1 L / 2 or
-/// less). The landing data hold what trials under gravity measured from F_1 up, and below it
-/// only the limit F = 0, where every impact stays; the response tables hold impacts at the
-/// gathering's speed, scaled. A landing that slow is the tumble going on, not an impact the table
-/// measured: with `WorldDef::ground_hulls` the body meets level ground with its hull
-/// (`ground_hull`), as one that was on it, and a hop's landing draws no fresh collision. Without
-/// landing data (tables before format 2.2, and 2D tables) it is false: bodies from flight keep the
-/// statistical response, as before.
+/// part along gravity) slower than a hop's landing: |v|^2 < F_h |g| L, F_h = `hop_froude`, L the
+/// signature's length. A hop of a tumbling body ends in such a landing. The landing data and the
+/// response tables hold impacts of a body from flight at any orientation; a landing that slow is
+/// the tumble going on, the body coming down on the part of its hull it turned over: with
+/// `WorldDef::ground_hulls` the body meets level ground with its hull (`ground_hull`), as one
+/// that was on it, and a hop's landing draws no fresh collision. Without landing data (tables
+/// before format 2.2, and 2D tables) it is false: bodies from flight keep the statistical
+/// response, as before.
 template <int D>
 bool slow_landing(const WorldData<D>& w, const Body<D>& b)
 {
   const Shape<D>& s = w.shapes[b.shape];
-  const LandingView& l = s.signature.landing;
-  if (!s.statistical || !l.present() || !(b.linear_velocity.dot(w.def.gravity) > 0)) return false;
-  const AxisView& froude = l.axes[2];
-  std::uint32_t k = 0;
-  while (k < froude.size && !(froude.values[k] > 0)) ++k;
-  if (k == froude.size) return false;
-  // |v|^2 < F_1 |g| L, squared: no root of |g|^2.
-  const Scalar v2 = b.linear_velocity.squaredNorm(), limit = froude.values[k] * s.signature.length;
+  if (!s.statistical || !s.signature.landing.present() || !(b.linear_velocity.dot(w.def.gravity) > 0)) return false;
+  // |v|^2 < F_h |g| L, squared: no root of |g|^2.
+  const Scalar v2 = b.linear_velocity.squaredNorm(), limit = hop_froude * s.signature.length;
   return v2 * v2 < limit * limit * w.def.gravity.squaredNorm();
 }
 

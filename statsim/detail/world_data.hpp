@@ -61,8 +61,8 @@ struct WorldData {
   std::uint32_t* rolled;
   /// With `WorldDef::ground_hulls`, bit set of the awake bodies that meet level ground with their
   /// hull in this step (`ground_hull`): those on the ground at its start (their `on_ground`
-  /// before `forget_contacts` clears it) and those landing slower than their table's landing data
-  /// measured (`slow_landing`); a body that arrives from flight faster gets the statistical
+  /// before `forget_contacts` clears it) and those landing as slowly as a hop's landing
+  /// (`slow_landing`); a body that arrives from flight faster gets the statistical
   /// response. Scratch of the step, written by `integrate` from the state at the step's start: a
   /// snapshot needs nothing.
   std::uint32_t* hull_ground;
