@@ -350,8 +350,10 @@ class WorldCore {
       }
     result.bodies_integrated = detail::integrate<FS>(w_, dt, [&](std::uint32_t i) {
       if constexpr (FS::slopes) {
-        // `on_ground` is still last step's: `forget_contacts` clears it below.
-        if (ground_hulls && (w_.bodies[i].on_ground || detail::slow_landing(w_, w_.bodies[i])))
+        // `on_ground` is still last step's: `forget_contacts` clears it below. A body that the
+        // table's response sent off (`leaves_ground`) flies.
+        const Body<D>& b = w_.bodies[i];
+        if (ground_hulls && ((b.on_ground && !detail::leaves_ground(w_, b)) || detail::slow_landing(w_, b)))
           detail::set_bit(w_.hull_ground, i);
         return hull_planes && detail::roll_on_slopes<FS>(w_, i, dt, impacts_, id);
       } else {

@@ -296,14 +296,15 @@ struct WorldDef {
   BodyContacts body_contacts = BodyContacts::automatic;
   /// Resting conditions of paper 3.4 for statistical bodies settling on a near-horizontal plane.
   bool rest_conditions = true;
-  /// Statistical bodies whose table has a support map meet level ground with their hull after
-  /// their first impact (`detail::ground_hull`, statsim/README.md, "Hull contacts on level ground"):
-  /// the impact from flight is the table's response, the tumbles and hops after it the hull's, in
-  /// 1 ms substeps, until the body chooses a rest pose; a landing as slow as a hop's (from a fall
-  /// of the centre of L / 2 or less) is the hull's too (`detail::slow_landing`). Single drops
-  /// nearer the reference on some shapes, at more time per step in piles
-  /// (tools/fidelity/README.md, "Hull contacts on level ground"). Needs `rest_conditions`; refused with `not_compiled` in a world without
-  /// `Features::slopes`, whose contact it takes.
+  /// Statistical bodies whose table has a support map meet level ground with their hull
+  /// (`detail::ground_hull`, statsim/README.md, "Hull contacts on level ground"): the impact from
+  /// flight is the table's response, taken where the hull touches; the tumbles and hops after it
+  /// are the hull's, in 1 ms substeps, until the body chooses a rest pose; a landing as slow as a
+  /// hop's (from a fall of the centre of L / 2 or less) is the hull's too
+  /// (`detail::slow_landing`), and a body the response sends off flies (`detail::leaves_ground`).
+  /// Single drops nearer the reference on some shapes, at more time per step in piles
+  /// (tools/fidelity/README.md, "Hull contacts on level ground"). Needs `rest_conditions`;
+  /// refused with `not_compiled` in a world without `Features::slopes`, whose contact it takes.
   bool ground_hulls = false;
   /// Bodies settling on other bodies (not on the ground) blend their radius to the shape's
   /// frequency-weighted mean rest height, without choosing a pose or turning. Off (the paper's

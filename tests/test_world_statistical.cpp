@@ -728,6 +728,86 @@ TEST_CASE("ground hulls: a landing slower than a hop's is the hull's, a faster o
   }
 }
 
+namespace {
+/// Drops `n` bodies of table `sig` onto level ground, each alone, at random orientations and
+/// spins, from 0.1 to 0.6 m above their bounding radius, with `WorldDef::ground_hulls`, for 3 s.
+/// Counts the impacts from flight faster than a hop's landing (`detail::slow_landing`: steps
+/// that begin with a body off the ground at |v|^2 >= F_h |g| L and end with it on it, without a
+/// rest pose), those that end with its centre more than a hundredth of its
+/// bounding radius from its hull's support toward the ground (`off_hull`); and the steps that
+/// begin with a body on the ground, without a rest pose, moving up as fast as a flight that
+/// rises more than the table's `hop` L (`flights`), those of them in which it took more than
+/// gravity (`braked`: its velocity's change off g dt by more than 0.1 mm/s).
+void ground_impacts(const SignatureView<3>& sig, int n, int& impacts, int& off_hull, int& flights, int& braked)
+{
+  WorldDef3 def;
+  def.ground_hulls = true;
+  const Scalar dt = Scalar(1) / 60;
+  auto w = std::make_unique<World3<32>>(def);
+  REQUIRE(w->construction_status() == Status::ok);
+  const ShapeId shape = w->add_shape(sig).id;
+  REQUIRE(w->add_plane(Vector3::UnitZ(), 0).ok());
+  const Scalar bound = w->shape(shape).bounding_radius;
+  Pcg32 g(29, 3);
+  for (int i = 0; i < n; ++i) {
+    BodyDef3 b;
+    b.shape = shape;
+    b.position = Vector3(Scalar(6) * Scalar(i), 0, bound + g.uniform(0.1f, 0.6f));
+    b.orientation = random_orientation(g);
+    b.angular_velocity = Vector3(g.uniform(-5.f, 5.f), g.uniform(-5.f, 5.f), g.uniform(-5.f, 5.f));
+    REQUIRE(w->add_body(b).ok());
+  }
+  const Scalar hop_speed2 = 2 * Scalar(9.81) * sig.landing.hop * sig.length;
+  const Scalar fast2 = detail::hop_froude * Scalar(9.81) * sig.length;
+  impacts = off_hull = flights = braked = 0;
+  std::vector<char> ground(std::size_t(n), 0);
+  std::vector<Vector3> v(static_cast<std::size_t>(n));
+  for (int s = 0; s < 180; ++s) {
+    for (int i = 0; i < n; ++i) {
+      const Body3& b = w->body(std::uint32_t(i));
+      ground[std::size_t(i)] = b.on_ground && b.rest_pose == no_rest_pose && b.state != MotionState::asleep;
+      v[std::size_t(i)] = b.linear_velocity;
+    }
+    REQUIRE(w->step(dt).ok());
+    for (int i = 0; i < n; ++i) {
+      const Body3& b = w->body(std::uint32_t(i));
+      const std::size_t k = std::size_t(i);
+      if (!ground[k] && b.on_ground && b.rest_pose == no_rest_pose && b.state != MotionState::asleep &&
+          v[k].squaredNorm() >= fast2) {
+        ++impacts;
+        const Scalar support = detail::support_along(sig.contact, detail::to_body(b.orientation, Vector3(-Vector3::UnitZ())));
+        off_hull += std::fabs(b.position.z() - support) > Scalar(0.01) * bound;
+      }
+      if (ground[k] && v[k].z() > 0 && v[k].z() * v[k].z() > hop_speed2) {
+        ++flights;
+        braked += (b.linear_velocity - v[k] - Vector3(0, 0, Scalar(-9.81) * dt)).norm() > Scalar(1e-4);
+      }
+    }
+  }
+}
+}  // namespace
+
+TEST_CASE("ground hulls: a body meets level ground from flight at its hull's support, and the table's response sends it off")
+{
+  // With `WorldDef::ground_hulls` the impact from flight is taken where the hull touches
+  // (`detail::ground_impact_on_hull`), not at the collision radius, from which the hull's contact
+  // after it lifted the centre to its support or let it fall there; a body the response sends off
+  // as a flight (`detail::leaves_ground`) flies, its hull's contact not taking the flight out.
+  for (const SignatureView<3>& sig : {tables::lshape.view(), tables::box.view(), tables::bunny.view()}) {
+    const std::string name = sig.name;
+    CAPTURE(name);
+    REQUIRE(sig.landing.present());
+    int impacts = 0, off_hull = 0, flights = 0, braked = 0;
+    ground_impacts(sig, 32, impacts, off_hull, flights, braked);
+    MESSAGE(name << ": " << impacts << " impacts from flight, " << off_hull << " of them off the hull's support; "
+                 << flights << " flights after a step on the ground, " << braked << " of them braked");
+    CHECK(impacts >= 32);
+    CHECK(off_hull == 0);
+    CHECK(flights >= 8);
+    CHECK(braked == 0);
+  }
+}
+
 TEST_CASE("ground hulls: refused without Features::slopes, the world unchanged")
 {
   WorldDef3 def;

@@ -10,6 +10,7 @@
 #include "statsim/detail/narrow_phase.hpp"
 #include "statsim/detail/world_data.hpp"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -70,8 +71,9 @@ bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>
 /// already on the ground, though, tumbles over its edges and hops on its corners, each strike set
 /// by the one before; drawing a fresh collision at each contact would make a sphere bounce where
 /// the rigid body rocks, and a sphere that rolls cannot hop. So the first impact from flight is
-/// the table's, and the contacts after it are the hull's, as on a slope, until a rest pose is
-/// chosen (`rolls_on`). Only with `WorldDef::ground_hulls` and `rest_conditions` (without them
+/// the table's, taken where the hull touches (`ground_impact_on_hull`), and the contacts after it
+/// are the hull's, as on a slope, until a rest pose is chosen (`rolls_on`) or the body flies off
+/// (`leaves_ground`). Only with `WorldDef::ground_hulls` and `rest_conditions` (without them
 /// bodies stay the paper's spheres), in worlds with `Features::slopes`.
 template <class FS = AllFeatures, int D>
 bool ground_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
@@ -109,6 +111,25 @@ bool slow_landing(const WorldData<D>& w, const Body<D>& b)
   // |v|^2 < F_h |g| L, squared: no root of |g|^2.
   const Scalar v2 = b.linear_velocity.squaredNorm(), limit = hop_froude * s.signature.length;
   return v2 * v2 < limit * limit * w.def.gravity.squaredNorm();
+}
+
+/// True when body `b`, statistical with landing data (`LandingView`), leaves the ground as a
+/// flight: its velocity against gravity v_up has v_up^2 > 2 |g| h L, its centre rising by more
+/// than the table's `hop` L (h) before it falls. A statistical response that sends a body off
+/// stands for the whole collision, every strike of its corners in it (the tables give what a
+/// rigid body leaves the ground with); were it still on its hull (`ground_hull`) in the next
+/// step, the corners its drawn spin turns down would strike again and take the flight out. So
+/// it flies, and lands on its hull (`ground_impact_on_hull`) with the table's response again or,
+/// as slowly as a hop's landing (`slow_landing`), on its hull. Without landing data it is false.
+template <int D>
+bool leaves_ground(const WorldData<D>& w, const Body<D>& b)
+{
+  const Shape<D>& s = w.shapes[b.shape];
+  if (!s.statistical || !s.signature.landing.present()) return false;
+  const Scalar up = -b.linear_velocity.dot(w.def.gravity);  // v_up |g|
+  // v_up^2 > 2 |g| h L, times |g|^2: no root of |g|^2.
+  return up > 0 && up * up > 2 * s.signature.landing.hop * s.signature.length * w.def.gravity.squaredNorm() *
+                                 std::sqrt(w.def.gravity.squaredNorm());
 }
 
 /// True when some body may meet a plane with its hull (`rolls_on`): the world has a tilted plane
@@ -183,8 +204,29 @@ Scalar held_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
   return hull < reach ? hull : reach;
 }
 
+/// True when body `b` (one of `w`'s bodies), not on its hull on the ground this step
+/// (`ground_hull`), meets level ground of unit normal `n` at its hull's support from flight: with
+/// `WorldDef::ground_hulls`, a statistical body with a support map and principal moments
+/// (`hull_shape`) and no rest pose. Its first impact is still the table's response, but taken
+/// where its hull touches, as the rigid body's is. Met at its collision radius instead, it stood
+/// where its hull was in the ground or above it, and the hull's contact that follows the impact
+/// lifted the centre to the support in a step, or let it fall there: a rise of centimetres on a
+/// long body (tools/fidelity/LOG.md, "Ground hulls: the first impact at the hull").
+template <class FS = AllFeatures, int D>
+bool ground_impact_on_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  if constexpr (!FS::slopes || !FS::statistical) {
+    return false;
+  }
+  if (!w.def.ground_hulls || !w.def.rest_conditions || b.rest_pose != no_rest_pose) return false;
+  if (!hull_shape(w.shapes[b.shape])) return false;
+  Scalar gn;
+  return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
+}
+
 /// `held_radius` against a plane, where it matters: the support is read only when the plane is
-/// within the body's bounding radius.
+/// within the body's bounding radius. With `WorldDef::ground_hulls`, a body that flies onto
+/// level ground meets it at its hull's support too (`ground_impact_on_hull`).
 template <class FS = AllFeatures, int D>
 Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& plane)
 {
@@ -192,10 +234,14 @@ Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& pla
   // every pass, and most need neither.
   const std::uint32_t i = std::uint32_t(&b - w.bodies);
   const bool slopes = FS::slopes && w.tilted_planes;
-  const bool ground = FS::slopes && w.def.ground_hulls && bit_set(w.hull_ground, i);
+  const bool ground_hulls = FS::slopes && w.def.ground_hulls;
+  const bool ground = ground_hulls && bit_set(w.hull_ground, i);
   const bool hulls = FS::hull_contacts && hull_contacts_on(w) && b.state == MotionState::settling;
-  if (!slopes && !ground && !hulls) return b.radius;
+  if (!slopes && !ground_hulls && !hulls) return b.radius;
   if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
+  if (ground_hulls && !ground && ground_impact_on_hull<FS>(w, b, plane.normal))
+    return support_along(w.shapes[b.shape].signature.contact, to_body(b.orientation, typename Space<D>::Vec(-plane.normal)));
+  if (!slopes && !ground && !hulls) return b.radius;
   return held_radius<FS>(w, b, plane.normal);
 }
 
