@@ -62,6 +62,21 @@ bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>
   return is_tilted_plane(w.def.gravity, n, gn);
 }
 
+/// True when body `b` can meet the plane of unit normal `n` with its hull on level ground: with
+/// `WorldDef::ground_hulls` and `rest_conditions`, the body statistical with a support map and
+/// principal moments (`hull_shape`), the plane level ground (it carries weight, and gravity has no
+/// part along it). When it does: `ground_hull`, `ground_impact_on_hull`.
+template <class FS = AllFeatures, int D>
+bool hull_meets_ground(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
+{
+  if constexpr (!FS::slopes || !FS::statistical) {
+    return false;
+  }
+  if (!w.def.ground_hulls || !w.def.rest_conditions || !hull_shape(w.shapes[b.shape])) return false;
+  Scalar gn;
+  return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
+}
+
 /// True when body `b` meets the plane of unit normal `n` with its hull because it is level ground
 /// (it carries weight, and gravity has no part along it) and the body is marked in
 /// `WorldData::hull_ground` for the step (on the ground as the step began, or landing slowly:
@@ -78,13 +93,7 @@ bool slope_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>
 template <class FS = AllFeatures, int D>
 bool ground_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
 {
-  if constexpr (!FS::slopes || !FS::statistical) {
-    return false;
-  }
-  if (!w.def.ground_hulls || !w.def.rest_conditions || !bit_set(w.hull_ground, std::uint32_t(&b - w.bodies))) return false;
-  if (!hull_shape(w.shapes[b.shape])) return false;
-  Scalar gn;
-  return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
+  return hull_meets_ground<FS>(w, b, n) && bit_set(w.hull_ground, std::uint32_t(&b - w.bodies));
 }
 
 /// The Froude number |v|^2 / (|g| L) below which a landing on level ground is a hop's
@@ -204,10 +213,9 @@ Scalar held_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
   return hull < reach ? hull : reach;
 }
 
-/// True when body `b` (one of `w`'s bodies), not on its hull on the ground this step
-/// (`ground_hull`), meets level ground of unit normal `n` at its hull's support from flight: with
-/// `WorldDef::ground_hulls`, a statistical body with a support map and principal moments
-/// (`hull_shape`) and no rest pose. Its first impact is still the table's response, but taken
+/// True when body `b` (one of `w`'s bodies) meets level ground of unit normal `n` at its hull's
+/// support also from flight, not only once on its hull there (`ground_hull`): a body that
+/// `hull_meets_ground` and has no rest pose. Its first impact is still the table's response, but taken
 /// where its hull touches, as the rigid body's is. Met at its collision radius instead, it stood
 /// where its hull was in the ground or above it, and the hull's contact that follows the impact
 /// lifted the centre to the support in a step, or let it fall there: a rise of centimetres on a
@@ -215,13 +223,7 @@ Scalar held_radius(const WorldData<D>& w, const Body<D>& b, const typename Space
 template <class FS = AllFeatures, int D>
 bool ground_impact_on_hull(const WorldData<D>& w, const Body<D>& b, const typename Space<D>::Vec& n)
 {
-  if constexpr (!FS::slopes || !FS::statistical) {
-    return false;
-  }
-  if (!w.def.ground_hulls || !w.def.rest_conditions || b.rest_pose != no_rest_pose) return false;
-  if (!hull_shape(w.shapes[b.shape])) return false;
-  Scalar gn;
-  return !is_tilted_plane(w.def.gravity, n, gn) && gn < 0;
+  return b.rest_pose == no_rest_pose && hull_meets_ground<FS>(w, b, n);
 }
 
 /// `held_radius` against a plane, where it matters: the support is read only when the plane is
@@ -239,7 +241,7 @@ Scalar plane_radius(const WorldData<D>& w, const Body<D>& b, const Plane<D>& pla
   const bool hulls = FS::hull_contacts && hull_contacts_on(w) && b.state == MotionState::settling;
   if (!slopes && !ground_hulls && !hulls) return b.radius;
   if (!(plane.normal.dot(b.position) - plane.offset < w.shapes[b.shape].bounding_radius)) return b.radius;
-  if (ground_hulls && !ground && ground_impact_on_hull<FS>(w, b, plane.normal))
+  if (ground_hulls && ground_impact_on_hull<FS>(w, b, plane.normal))
     return support_along(w.shapes[b.shape].signature.contact, to_body(b.orientation, typename Space<D>::Vec(-plane.normal)));
   if (!slopes && !ground && !hulls) return b.radius;
   return held_radius<FS>(w, b, plane.normal);
